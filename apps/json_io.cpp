@@ -1,0 +1,157 @@
+#include "json_io.hpp"
+
+#include <set>
+#include <stdexcept>
+
+namespace diffpills::app {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+[[noreturn]] void fail(const std::string& field, const std::string& problem) {
+  throw std::invalid_argument(field + ": " + problem);
+}
+
+const json& member(const json& object, const std::string& key, const std::string& name) {
+  const auto it = object.find(key);
+  if (it == object.end()) {
+    fail(name + "." + key, "missing");
+  }
+  return *it;
+}
+
+double number(const json& value, const std::string& field) {
+  if (!value.is_number()) {
+    fail(field, "must be a number");
+  }
+  return value.get<double>();
+}
+
+template <int N>
+Eigen::Matrix<double, N, 1> vector(const json& value, const std::string& field) {
+  if (!value.is_array() || value.size() != N) {
+    fail(field, "must be an array of " + std::to_string(N) + " numbers");
+  }
+  Eigen::Matrix<double, N, 1> out;
+  for (int i = 0; i < N; ++i) {
+    out(i) = number(value[static_cast<std::size_t>(i)], field + "[" + std::to_string(i) + "]");
+  }
+  return out;
+}
+
+void reject_unknown_fields(const json& object, const std::set<std::string>& allowed,
+                           const std::string& name) {
+  for (const auto& item : object.items()) {
+    if (allowed.count(item.key()) == 0) {
+      fail(name + "." + item.key(), "unknown field");
+    }
+  }
+}
+
+// Library messages start with a generic owner ("capsule.", "polygon.", "pose."); replace it with
+// the shape's own name so the field is unambiguous in a query with two shapes.
+std::string rename_field(const std::string& message, const std::string& owner,
+                         const std::string& name) {
+  return message.rfind(owner, 0) == 0 ? name + "." + message.substr(owner.size()) : message;
+}
+
+Shape parse_shape(const json& value, const std::string& name, const std::string& type) {
+  if (type == "capsule") {
+    reject_unknown_fields(value, {"type", "length", "radius", "r", "q"}, name);
+    try {
+      return Capsule(number(member(value, "length", name), name + ".length"),
+                     number(member(value, "radius", name), name + ".radius"));
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument(rename_field(error.what(), "capsule.", name));
+    }
+  }
+  if (type == "polygon") {
+    reject_unknown_fields(value, {"type", "C", "d", "radius", "r", "q"}, name);
+    const json& rows = member(value, "C", name);
+    const json& offsets = member(value, "d", name);
+    if (!rows.is_array()) fail(name + ".C", "must be an array of [c1, c2] rows");
+    if (!offsets.is_array()) fail(name + ".d", "must be an array of numbers");
+    Eigen::MatrixX2d C(static_cast<Eigen::Index>(rows.size()), 2);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const Eigen::Vector2d row = vector<2>(rows[i], name + ".C[" + std::to_string(i) + "]");
+      C.row(static_cast<Eigen::Index>(i)) = row.transpose();
+    }
+    Eigen::VectorXd d(static_cast<Eigen::Index>(offsets.size()));
+    for (std::size_t i = 0; i < offsets.size(); ++i) {
+      d(static_cast<Eigen::Index>(i)) = number(offsets[i], name + ".d[" + std::to_string(i) + "]");
+    }
+    const double radius = number(member(value, "radius", name), name + ".radius");
+    try {
+      return PaddedPolygon(C, d, radius);
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument(rename_field(error.what(), "polygon.", name));
+    }
+  }
+  fail(name + ".type", "must be \"capsule\" or \"polygon\"");
+}
+
+json rows(const Eigen::MatrixXd& matrix) {
+  json out = json::array();
+  for (Eigen::Index i = 0; i < matrix.rows(); ++i) {
+    json row = json::array();
+    for (Eigen::Index j = 0; j < matrix.cols(); ++j) row.push_back(matrix(i, j));
+    out.push_back(row);
+  }
+  return out;
+}
+
+json list(const Eigen::VectorXd& v) { return json(std::vector<double>(v.data(), v.data() + v.size())); }
+
+}  // namespace
+
+PosedShape parse_posed_shape(const json& value, const std::string& name) {
+  if (!value.is_object()) {
+    fail(name, "must be an object");
+  }
+  const json& type = member(value, "type", name);
+  if (!type.is_string()) {
+    fail(name + ".type", "must be \"capsule\" or \"polygon\"");
+  }
+  Shape shape = parse_shape(value, name, type.get<std::string>());
+  const Eigen::Vector3d r = vector<3>(member(value, "r", name), name + ".r");
+  const Eigen::Vector4d q = vector<4>(member(value, "q", name), name + ".q");
+  try {
+    return {std::move(shape), Pose(r, q)};
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(rename_field(error.what(), "pose.", name));
+  }
+}
+
+json to_json(const Shape& shape, const Pose& pose) {
+  json out;
+  if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+    out = {{"type", "capsule"}, {"length", capsule->length()}, {"radius", capsule->radius()}};
+  } else {
+    const auto& polygon = std::get<PaddedPolygon>(shape);
+    out = {{"type", "polygon"},
+           {"C", rows(polygon.constraint_matrix())},
+           {"d", list(polygon.constraint_offsets())},
+           {"radius", polygon.radius()}};
+  }
+  out["r"] = list(pose.r());
+  out["q"] = list(pose.q());
+  return out;
+}
+
+json to_json(const Proximity& result) {
+  return {{"phi", result.phi},
+          {"core_points", {list(result.core_points[0]), list(result.core_points[1])}},
+          {"points", {list(result.points[0]), list(result.points[1])}},
+          {"normal", list(result.normal)},
+          {"gradient", list(result.gradient)},
+          {"cores_intersect", result.cores_intersect}};
+}
+
+json to_json(const ProximityJacobian& result) {
+  json out = to_json(static_cast<const Proximity&>(result));
+  out["jacobian"] = {{"core_points", rows(result.core_points_jacobian)},
+                     {"points", rows(result.points_jacobian)}};
+  return out;
+}
+
+}  // namespace diffpills::app

@@ -1,0 +1,11 @@
+// diffpills: differentiable collision detection for capsules and padded polygons.
+// The umbrella header; see each header for its part of the contract.
+#pragma once
+
+#include "diffpills/proximity.hpp"
+#include "diffpills/qp/backward.hpp"
+#include "diffpills/qp/box_active_set.hpp"
+#include "diffpills/qp/interior_point.hpp"
+#include "diffpills/rotation.hpp"
+#include "diffpills/shapes.hpp"
+#include "diffpills/version.hpp"

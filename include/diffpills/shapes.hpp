@@ -1,0 +1,96 @@
+// The two primitives and their pose (DESIGN.md sections 1-2).
+//
+// Padding is a radius on a core, not a new shape: a capsule is a segment padded by R, a padded
+// polygon is a planar convex polygon padded by R. All three types validate on construction and
+// throw std::invalid_argument whose message starts with the offending field, e.g.
+// "capsule.radius: must be >= 0 (got -1)". Once constructed they are immutable values, cheap to
+// copy (a polygon shares nothing mutable), and safe to use from any thread.
+#pragma once
+
+#include <Eigen/Core>
+#include <variant>
+
+namespace diffpills {
+
+// Magnitudes above this are rejected: squared distances of such inputs would overflow and turn a
+// result into inf or NaN. 1e100 squared is 1e200, still comfortably finite.
+inline constexpr double kMaxMagnitude = 1e100;
+
+// A capsule: the core segment runs along the body x axis from [-L/2, 0, 0] to [L/2, 0, 0] and is
+// padded by the radius R. L = 0 is a sphere.
+class Capsule {
+ public:
+  // Throws std::invalid_argument unless 0 <= length, radius <= kMaxMagnitude (finite).
+  Capsule(double length, double radius);
+
+  double length() const { return length_; }
+  double radius() const { return radius_; }
+
+ private:
+  double length_;
+  double radius_;
+};
+
+// A padded polygon: the core is {y in R^2 : C y <= d} in the body x-y plane, padded by the radius
+// R. Requirements (each violation throws std::invalid_argument naming the field):
+//   - C is m x 2 and d has m entries, m >= 3, every entry finite;
+//   - d > 0: the body origin lies strictly inside the polygon;
+//   - the polygon is bounded;
+//   - 0 <= radius <= kMaxMagnitude.
+// Redundant rows (zero rows, rows implied by others, duplicates) are allowed and dropped. The
+// constructor computes the polygon's vertices once, in O(m log m), through the polar dual: with
+// d > 0 the half-plane c_i y <= d_i maps to the point c_i / d_i, the rows that bound the polygon
+// are the vertices of the convex hull of those points, and the polygon is bounded exactly when the
+// origin lies strictly inside that hull.
+class PaddedPolygon {
+ public:
+  PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d, double radius);
+
+  // The rows exactly as given, for round trips (serialization, pickling).
+  const Eigen::MatrixX2d& constraint_matrix() const { return C_; }
+  const Eigen::VectorXd& constraint_offsets() const { return d_; }
+  double radius() const { return radius_; }
+
+  // The k non-redundant rows, normalized to unit normals, ordered counterclockwise by the angle of
+  // their normal: edge_normals() y <= edge_offsets() describes the same polygon.
+  const Eigen::MatrixX2d& edge_normals() const { return normals_; }
+  const Eigen::VectorXd& edge_offsets() const { return offsets_; }
+  // The k vertices, counterclockwise; vertex i joins edge i and edge i + 1 (mod k).
+  const Eigen::MatrixX2d& vertices() const { return vertices_; }
+  // max_i |vertex_i|: the radius of the smallest origin-centred disc holding the core, used as the
+  // polygon's length scale for relative tolerances.
+  double extent() const { return extent_; }
+
+ private:
+  Eigen::MatrixX2d C_;
+  Eigen::VectorXd d_;
+  double radius_;
+  Eigen::MatrixX2d normals_;
+  Eigen::VectorXd offsets_;
+  Eigen::MatrixX2d vertices_;
+  double extent_ = 0.0;
+};
+
+// A rigid-body pose: x_world = r + Q(q) x_body with q = [w, x, y, z] (scalar first). q need not be
+// unit; it is normalized wherever it is used, and derivatives include that normalization.
+class Pose {
+ public:
+  // The identity pose.
+  Pose();
+  // Throws std::invalid_argument ("pose.r: ...", "pose.q: ...") for non-finite entries, |entries|
+  // above kMaxMagnitude, or a quaternion whose norm is zero (below 1e-150, where its square
+  // underflows and no direction can be recovered).
+  Pose(const Eigen::Vector3d& r, const Eigen::Vector4d& q);
+
+  const Eigen::Vector3d& r() const { return r_; }
+  const Eigen::Vector4d& q() const { return q_; }
+
+ private:
+  Eigen::Vector3d r_;
+  Eigen::Vector4d q_;
+};
+
+// Either primitive, for code that handles shapes chosen at run time (the command line, bindings).
+using Shape = std::variant<Capsule, PaddedPolygon>;
+
+}  // namespace diffpills

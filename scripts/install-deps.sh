@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages diffpills needs, but only those that are missing, so that
+# `make test` and `make demo` work on a fresh machine and cost nothing on a prepared one.
+# Uses sudo when not run as root. The package list is DESIGN.md section 6.
+set -euo pipefail
+
+packages=(
+  build-essential cmake
+  libeigen3-dev          # linear algebra
+  libgtest-dev           # unit tests
+  libbenchmark-dev       # benchmarks
+  libfcl-dev             # independent distances for tests and benchmarks
+  nlohmann-json3-dev     # JSON for `diffpills query`
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+
+if [ "${#missing[@]}" -eq 0 ]; then
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  sudo_cmd=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
