@@ -89,6 +89,10 @@ void InteriorPointSolver::update_residuals(const Eigen::MatrixXd& P, const Eigen
 //   [ G_A  0    ] [ lambda_A ] = [ h_A - G_A x ]
 // by a complete orthogonal decomposition, which returns the minimum-norm solution when the
 // minimizer is not unique or active rows are dependent, and accept x + dx if it is a KKT point.
+// At a degenerate vertex (more active rows than variables) the multipliers are not unique and
+// the minimum-norm ones may have a negative entry although nonnegative ones exist; the row with
+// the most negative multiplier is then dropped and the system solved again, as an active-set
+// method would, up to once per guessed row.
 bool InteriorPointSolver::try_polish(const Eigen::MatrixXd& P, const Eigen::VectorXd& c,
                                      const Eigen::VectorXd& h) {
   const Eigen::Index n = x_.size();
@@ -98,44 +102,53 @@ bool InteriorPointSolver::try_polish(const Eigen::MatrixXd& P, const Eigen::Vect
       active.push_back(i);
     }
   }
-  const auto k = static_cast<Eigen::Index>(active.size());
-  Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(n + k, n + k);
-  Eigen::VectorXd rhs(n + k);
-  kkt.topLeftCorner(n, n) = P;
-  rhs.head(n) = -(P * x_ + c);
-  for (Eigen::Index j = 0; j < k; ++j) {
-    const Eigen::Index row = active[static_cast<std::size_t>(j)];
-    kkt.block(n + j, 0, 1, n) = G_.row(row);
-    kkt.block(0, n + j, n, 1) = G_.row(row).transpose();
-    rhs(n + j) = h(row) - G_.row(row).dot(x_);
-  }
-  const Eigen::VectorXd solution = kkt.completeOrthogonalDecomposition().solve(rhs);
   const double tolerance = settings_.polish_tolerance;
-  if (!solution.allFinite() ||
-      inf_norm(kkt * solution - rhs) > tolerance * (1.0 + inf_norm(rhs) + inf_norm(c))) {
-    return false;  // the guessed active set admits no KKT point
-  }
-  const Eigen::VectorXd x = x_ + solution.head(n);
-  const Eigen::VectorXd slack = h - G_ * x;
-  if (slack.minCoeff() < -tolerance * (1.0 + inf_norm(h))) {
-    return false;  // a constraint left out of the guess is violated
-  }
-  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(s_.size());
-  for (Eigen::Index j = 0; j < k; ++j) {
-    const double multiplier = solution(n + j);
-    if (multiplier < -tolerance * (1.0 + inf_norm(c))) {
-      return false;  // a constraint in the guess pushes the wrong way
+  while (true) {
+    const auto k = static_cast<Eigen::Index>(active.size());
+    Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(n + k, n + k);
+    Eigen::VectorXd rhs(n + k);
+    kkt.topLeftCorner(n, n) = P;
+    rhs.head(n) = -(P * x_ + c);
+    for (Eigen::Index j = 0; j < k; ++j) {
+      const Eigen::Index row = active[static_cast<std::size_t>(j)];
+      kkt.block(n + j, 0, 1, n) = G_.row(row);
+      kkt.block(0, n + j, n, 1) = G_.row(row).transpose();
+      rhs(n + j) = h(row) - G_.row(row).dot(x_);
     }
-    lambda(active[static_cast<std::size_t>(j)]) = std::max(multiplier, 0.0);
+    const Eigen::VectorXd solution = kkt.completeOrthogonalDecomposition().solve(rhs);
+    if (!solution.allFinite() ||
+        inf_norm(kkt * solution - rhs) > tolerance * (1.0 + inf_norm(rhs) + inf_norm(c))) {
+      return false;  // the guessed active set admits no KKT point
+    }
+    const Eigen::VectorXd x = x_ + solution.head(n);
+    const Eigen::VectorXd slack = h - G_ * x;
+    if (slack.minCoeff() < -tolerance * (1.0 + inf_norm(h))) {
+      return false;  // a constraint left out of the guess is violated
+    }
+    Eigen::Index most_negative = -1;
+    for (Eigen::Index j = 0; j < k; ++j) {
+      if (solution(n + j) < -tolerance * (1.0 + inf_norm(c)) &&
+          (most_negative < 0 || solution(n + j) < solution(n + most_negative))) {
+        most_negative = j;
+      }
+    }
+    if (most_negative >= 0) {
+      active.erase(active.begin() + most_negative);  // a row in the guess pushes the wrong way
+      continue;
+    }
+    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(s_.size());
+    for (Eigen::Index j = 0; j < k; ++j) {
+      lambda(active[static_cast<std::size_t>(j)]) = std::max(solution(n + j), 0.0);
+    }
+    result_.x = x;
+    result_.s = slack.cwiseMax(0.0);
+    result_.lambda = lambda;
+    result_.polished = true;
+    result_.primal_residual = inf_norm(G_ * x + result_.s - h);
+    result_.dual_residual = inf_norm(P * x + c + G_.transpose() * lambda);
+    result_.complementarity = result_.s.dot(lambda) / static_cast<double>(s_.size());
+    return true;
   }
-  result_.x = x;
-  result_.s = slack.cwiseMax(0.0);
-  result_.lambda = lambda;
-  result_.polished = true;
-  result_.primal_residual = inf_norm(G_ * x + result_.s - h);
-  result_.dual_residual = inf_norm(P * x + c + G_.transpose() * lambda);
-  result_.complementarity = result_.s.dot(lambda) / static_cast<double>(s_.size());
-  return true;
 }
 
 const InteriorPointResult& InteriorPointSolver::solve(const Eigen::MatrixXd& P,
@@ -208,7 +221,21 @@ const InteriorPointResult& InteriorPointSolver::solve(const Eigen::MatrixXd& P,
     affine_.s += corrector_.s;
     affine_.lambda += corrector_.lambda;
     // 0.99 of the way to the boundary keeps the iterate strictly interior.
-    const double alpha = std::min(1.0, 0.99 * step_to_boundary(affine_));
+    double alpha = std::min(1.0, 0.99 * step_to_boundary(affine_));
+    // Safeguard. For a QP the step's second-order term ds'dl = dx'P dx is never negative, so a
+    // long Mehrotra step can raise the mean complementarity, and the next step undo it: seen as
+    // a two-cycle with mu frozen near 0.1 on a random 5-variable QP. Once the iterate is
+    // feasible to 1e-6 (relative) and only mu is left to drive down, the step is halved until mu
+    // decreases by at least 1% of the step, which breaks the cycle. Earlier, while the residuals
+    // are still being removed, mu may legitimately rise and the step is left alone.
+    if (std::max(inf_norm(r_primal_) / h_scale, inf_norm(r_dual_) / c_scale) <= 1e-6) {
+      for (int halving = 0; halving < 30; ++halving) {
+        const double mu_next =
+            (s_ + alpha * affine_.s).dot(lambda_ + alpha * affine_.lambda) / static_cast<double>(m);
+        if (mu_next <= (1.0 - 0.01 * alpha) * mu) break;
+        alpha *= 0.5;
+      }
+    }
     x_ += alpha * affine_.x;
     s_ += alpha * affine_.s;
     lambda_ += alpha * affine_.lambda;
@@ -223,8 +250,9 @@ const InteriorPointResult& InteriorPointSolver::solve(const Eigen::MatrixXd& P,
     result_.dual_residual = inf_norm(r_dual_);
     result_.complementarity = s_.dot(lambda_) / static_cast<double>(m);
   }
-  // Leave the factorization at the final interior iterate for the backward pass.
-  w_ = (lambda_.array() / s_.array()).matrix();
+  // Leave a factorization for the backward pass (see the header for the choice of point).
+  const double delta = 3e-10 * (1.0 + inf_norm(h));
+  w_ = (result_.lambda.array().max(delta * delta) / result_.s.array().max(delta)).matrix();
   if (!factor(P) && result_.status == Status::kSolved) {
     result_.status = Status::kNumericalFailure;
   }

@@ -40,7 +40,9 @@ struct InteriorPointSettings {
   // 1 + |c|inf) and the mean complementarity s'lambda / m (against 1 + |objective|).
   double tolerance = 1e-12;
   bool polish = true;
-  // Polishing is attempted once every residual is below this (relative) level.
+  // Polishing is attempted once every residual is below this (relative) level. Waiting longer
+  // buys nothing and can hurt: at a vertex fixed by n active rows, W = lambda / s grows past
+  // 1e20 and rounding in the reduced system makes the dual residual grow again.
   double polish_threshold = 1e-9;
   // A polished point is accepted when every constraint holds and every active multiplier is
   // nonnegative to this relative level (a right active set gives residuals near rounding).
@@ -71,8 +73,16 @@ class InteriorPointSolver {
   const InteriorPointResult& result() const { return result_; }
   const InteriorPointSettings& settings() const { return settings_; }
 
-  // The last problem and the factorization of P + G'WG at the final interior iterate, for the
-  // backward pass (qp/backward.hpp).
+  // The last problem and a factorization of P + G'WG for the backward pass (qp/backward.hpp).
+  // It is taken at the returned solution with slacks floored at delta = 3e-10 and multipliers at
+  // delta^2 (both relative to 1 + |h|inf): W = lambda_i / delta on active rows, delta^2 / s_i on
+  // inactive ones. The backward pass then errs by about delta / lambda_i (W finite on active
+  // rows), eps * W (forming P + G'WG rounds P at that level) and delta^2 / s_i (inactive rows
+  // leak in), amplified by the conditioning of the active rows. Measured worst relative errors:
+  // random QPs of up to 4 variables 6e-5 / 6e-6 / 1.9e-6 / 4e-6 for delta = 1e-8 / 1e-9 / 3e-10 /
+  // 1e-10; proximity QPs 8e-8 / 8e-9 / 2e-9 / 1e-9. Flooring multipliers at delta instead of
+  // delta^2 let an inactive row with slack 0.08 leak an error of 1e-5; the unfloored final iterate
+  // of an unpolished solve (W ~ 1e14) gave 2e-2.
   const Eigen::MatrixXd& G() const { return G_; }
   const Eigen::VectorXd& weights() const { return w_; }
   const Eigen::LLT<Eigen::MatrixXd>& factorization() const { return llt_; }

@@ -1,0 +1,115 @@
+// Rotation utilities against Eigen's quaternions and central differences.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+
+#include "diffpills/rotation.hpp"
+
+namespace diffpills {
+namespace {
+
+using Rng = std::mt19937_64;
+
+Eigen::Vector4d random_quaternion(Rng& rng) {
+  std::normal_distribution<double> normal;
+  Eigen::Vector4d q(normal(rng), normal(rng), normal(rng), normal(rng));
+  return q * std::uniform_real_distribution<double>(0.3, 3.0)(rng) / q.norm();  // not unit
+}
+
+Eigen::Vector3d random_vector(Rng& rng) {
+  std::normal_distribution<double> normal;
+  return {normal(rng), normal(rng), normal(rng)};
+}
+
+template <class Function>
+Eigen::Matrix<double, 3, 4> differences(const Function& f, const Eigen::Vector4d& q) {
+  Eigen::Matrix<double, 3, 4> out;
+  for (int j = 0; j < 4; ++j) {
+    const double step = 1e-6;
+    Eigen::Vector4d plus = q, minus = q;
+    plus(j) += step;
+    minus(j) -= step;
+    out.col(j) = (f(plus) - f(minus)) / (2 * step);
+  }
+  return out;
+}
+
+TEST(Rotation, MatchesEigenQuaternionForNonUnitInput) {
+  Rng rng(1);
+  for (int i = 0; i < 1000; ++i) {
+    const Eigen::Vector4d q = random_quaternion(rng);
+    const Eigen::Quaterniond eigen(q(0), q(1), q(2), q(3));
+    const Eigen::Matrix3d R = rotation_matrix(q);
+    EXPECT_LE((R - eigen.normalized().toRotationMatrix()).cwiseAbs().maxCoeff(), 1e-14);
+    EXPECT_LE((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-14);
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-14);
+  }
+}
+
+TEST(Rotation, JacobiansMatchCentralDifferences) {
+  Rng rng(2);
+  for (int i = 0; i < 1000; ++i) {
+    const Eigen::Vector4d q = random_quaternion(rng);
+    const Eigen::Vector3d v = random_vector(rng);
+    const auto rotate = [&](const Eigen::Vector4d& p) { return Eigen::Vector3d(rotation_matrix(p) * v); };
+    const auto rotate_back = [&](const Eigen::Vector4d& p) {
+      return Eigen::Vector3d(rotation_matrix(p).transpose() * v);
+    };
+    EXPECT_LE((rotate_jacobian(q, v) - differences(rotate, q)).cwiseAbs().maxCoeff(), 1e-8);
+    EXPECT_LE((rotate_transpose_jacobian(q, v) - differences(rotate_back, q)).cwiseAbs().maxCoeff(), 1e-8);
+    // Normalization is built in: no sensitivity along q itself.
+    EXPECT_LE((rotate_jacobian(q, v) * q).norm(), 1e-12 * v.norm());
+  }
+}
+
+TEST(Rotation, LeftMultiplyAndAttitudeJacobian) {
+  Rng rng(3);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector4d q = random_quaternion(rng);
+    const Eigen::Vector4d p = random_quaternion(rng);
+    const Eigen::Quaterniond product = Eigen::Quaterniond(q(0), q(1), q(2), q(3)) *
+                                       Eigen::Quaterniond(p(0), p(1), p(2), p(3));
+    const Eigen::Vector4d expected(product.w(), product.x(), product.y(), product.z());
+    EXPECT_LE((left_multiply_matrix(q) * p - expected).norm(), 1e-13);
+    // dq/dtheta of q (x) [1, theta/2] is 1/2 G(q).
+    const Eigen::Matrix<double, 4, 3> G = attitude_jacobian(q);
+    for (int j = 0; j < 3; ++j) {
+      Eigen::Vector4d bump = Eigen::Vector4d::UnitX();  // [1, 0, 0, 0]
+      bump(1 + j) = 0.5 * 1e-6;
+      Eigen::Vector4d back = Eigen::Vector4d::UnitX();
+      back(1 + j) = -0.5 * 1e-6;
+      const Eigen::Vector4d fd =
+          (left_multiply_matrix(q) * bump - left_multiply_matrix(q) * back) / 2e-6;
+      EXPECT_LE((0.5 * G.col(j) - fd).norm(), 1e-9);
+    }
+  }
+}
+
+TEST(Rotation, ModifiedRodriguesParametersRoundTrip) {
+  Rng rng(4);
+  for (int i = 0; i < 1000; ++i) {
+    const Eigen::Vector4d q = random_quaternion(rng);
+    const Eigen::Vector3d p = quaternion_to_mrp(q);
+    EXPECT_LE(p.norm(), 1.0 + 1e-15);  // shadow set chosen
+    const Eigen::Vector4d back = mrp_to_quaternion(p);
+    EXPECT_NEAR(back.norm(), 1.0, 1e-14);
+    // Same attitude: q and back agree up to sign.
+    const Eigen::Vector4d unit = q.normalized();
+    EXPECT_LE(std::min((back - unit).norm(), (back + unit).norm()), 1e-13);
+    EXPECT_LE((rotation_matrix(back) - rotation_matrix(q)).cwiseAbs().maxCoeff(), 1e-13);
+    // Jacobian of the conversion.
+    Eigen::Matrix<double, 4, 3> fd;
+    for (int j = 0; j < 3; ++j) {
+      Eigen::Vector3d plus = p, minus = p;
+      plus(j) += 1e-6;
+      minus(j) -= 1e-6;
+      fd.col(j) = (mrp_to_quaternion(plus) - mrp_to_quaternion(minus)) / 2e-6;
+    }
+    EXPECT_LE((mrp_to_quaternion_jacobian(p) - fd).cwiseAbs().maxCoeff(), 1e-8);
+  }
+  EXPECT_EQ(quaternion_to_mrp(Eigen::Vector4d(1, 0, 0, 0)), Eigen::Vector3d::Zero());
+}
+
+}  // namespace
+}  // namespace diffpills

@@ -1,0 +1,146 @@
+// Shape and pose validation, and the polygon's precomputed vertices and reduced rows.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "diffpills/diffpills.hpp"
+
+namespace diffpills {
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Expects std::invalid_argument whose message starts with `field`.
+template <class Function>
+void expect_invalid(const Function& make, const std::string& field) {
+  try {
+    make();
+    ADD_FAILURE() << "no exception; expected one naming " << field;
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()).rfind(field, 0), 0u)
+        << "message '" << error.what() << "' does not start with " << field;
+  }
+}
+
+Eigen::MatrixX2d square_rows() {
+  return (Eigen::MatrixX2d(4, 2) << 1, 0, 0, 1, -1, 0, 0, -1).finished();
+}
+
+PaddedPolygon regular_polygon(int sides, double apothem, double radius) {
+  Eigen::MatrixX2d C(sides, 2);
+  for (int i = 0; i < sides; ++i) C.row(i) << std::cos(2 * M_PI * i / sides), std::sin(2 * M_PI * i / sides);
+  return PaddedPolygon(C, Eigen::VectorXd::Constant(sides, apothem), radius);
+}
+
+TEST(Shapes, SquareVerticesCounterclockwise) {
+  const PaddedPolygon square(square_rows(), Eigen::Vector4d(1, 2, 1, 2), 0.1);
+  ASSERT_EQ(square.vertices().rows(), 4);
+  double area = 0.0;  // shoelace: positive for counterclockwise
+  for (int i = 0; i < 4; ++i) {
+    const Eigen::Vector2d a = square.vertices().row(i), b = square.vertices().row((i + 1) % 4);
+    area += 0.5 * (a.x() * b.y() - a.y() * b.x());
+    EXPECT_NEAR(std::abs(a.x()), 1.0, 1e-15);
+    EXPECT_NEAR(std::abs(a.y()), 2.0, 1e-15);
+  }
+  EXPECT_NEAR(area, 8.0, 1e-14);
+  EXPECT_NEAR(square.extent(), std::sqrt(5.0), 1e-15);
+}
+
+TEST(Shapes, HexagonVerticesLieOnCircumcircle) {
+  const PaddedPolygon hexagon = regular_polygon(6, 0.6, 0.05);
+  ASSERT_EQ(hexagon.vertices().rows(), 6);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_NEAR(hexagon.vertices().row(i).norm(), 0.6 / std::cos(M_PI / 6), 1e-14);
+  }
+}
+
+TEST(Shapes, RedundantRowsAreDropped) {
+  Eigen::MatrixX2d C(8, 2);
+  C << 1, 0, 0, 1, -1, 0, 0, -1,  // the unit square's rows
+      3, 0,                       // a duplicate at another scale
+      0, 0,                       // a zero row
+      1, 1,                       // a row through the corner (1, 1): touches, never binds alone
+      -1, -1;                     // a loose row
+  Eigen::VectorXd d(8);
+  d << 1, 1, 1, 1, 3, 5, 2, 7;
+  const PaddedPolygon polygon(C, d, 0.0);
+  EXPECT_EQ(polygon.edge_normals().rows(), 4);
+  EXPECT_EQ(polygon.vertices().rows(), 4);
+  EXPECT_EQ(polygon.constraint_matrix().rows(), 8);  // the original rows are kept for round trips
+  for (Eigen::Index i = 0; i < 4; ++i) {
+    EXPECT_NEAR(polygon.edge_normals().row(i).norm(), 1.0, 1e-15);
+    EXPECT_NEAR(polygon.edge_offsets()(i), 1.0, 1e-15);
+  }
+}
+
+TEST(Shapes, ClockwiseInputStillYieldsCounterclockwiseVertices) {
+  Eigen::MatrixX2d C(3, 2);
+  C << 0, -1, -1, 1, 1, 1;  // a triangle, rows given clockwise
+  const PaddedPolygon triangle(C, Eigen::Vector3d(1, 1, 1), 0.0);
+  const auto& v = triangle.vertices();
+  ASSERT_EQ(v.rows(), 3);
+  double area = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    area += 0.5 * (v(i, 0) * v((i + 1) % 3, 1) - v(i, 1) * v((i + 1) % 3, 0));
+  }
+  EXPECT_GT(area, 0.0);
+}
+
+TEST(Shapes, TwoThousandRowPolygonIsReducedAndQueried) {
+  const PaddedPolygon big = regular_polygon(2000, 1.0, 0.0);
+  EXPECT_EQ(big.vertices().rows(), 2000);
+  // A sphere 3 above the centre and one beside the rim, against the analytic answers.
+  const Capsule sphere(0.0, 0.0);
+  const Proximity above = proximity(sphere, Pose({0, 0, 3}, {1, 0, 0, 0}), big, Pose());
+  EXPECT_NEAR(above.phi, 9.0, 1e-9);
+  const Proximity beside = proximity(sphere, Pose({3, 0, 0}, {1, 0, 0, 0}), big, Pose());
+  EXPECT_NEAR(std::sqrt(beside.phi), 2.0, 1e-9);  // (1, 0) is a vertex-free edge midpoint
+}
+
+TEST(Shapes, CapsuleRejectsBadSizes) {
+  expect_invalid([] { Capsule(-1.0, 0.1); }, "capsule.length");
+  expect_invalid([] { Capsule(1.0, -0.1); }, "capsule.radius");
+  expect_invalid([] { Capsule(kNan, 0.1); }, "capsule.length");
+  expect_invalid([] { Capsule(1.0, kInf); }, "capsule.radius");
+  expect_invalid([] { Capsule(1e200, 0.1); }, "capsule.length");
+  EXPECT_NO_THROW(Capsule(0.0, 0.0));  // a point is a valid (degenerate) capsule
+}
+
+TEST(Shapes, PoseRejectsBadNumbers) {
+  expect_invalid([] { Pose({0, kNan, 0}, {1, 0, 0, 0}); }, "pose.r[1]");
+  expect_invalid([] { Pose({0, 0, 0}, {1, kInf, 0, 0}); }, "pose.q[1]");
+  expect_invalid([] { Pose({0, 0, 0}, {0, 0, 0, 0}); }, "pose.q");
+  expect_invalid([] { Pose({0, 0, 0}, {1e-170, 0, 0, 0}); }, "pose.q");
+  EXPECT_NO_THROW(Pose({0, 0, 0}, {1e-100, 0, 0, 0}));
+}
+
+TEST(Shapes, PolygonRejectsBadRows) {
+  expect_invalid([] { PaddedPolygon(Eigen::MatrixX2d(2, 2), Eigen::Vector2d(1, 1), 0.1); },
+                 "polygon.C");  // fewer than 3 rows
+  expect_invalid([] { PaddedPolygon(square_rows(), Eigen::Vector3d(1, 1, 1), 0.1); },
+                 "polygon.d");  // size mismatch
+  expect_invalid([] { PaddedPolygon(square_rows(), Eigen::Vector4d(1, 1, 0, 1), 0.1); },
+                 "polygon.d[2]");  // origin on the boundary
+  expect_invalid([] { PaddedPolygon(square_rows(), Eigen::Vector4d(1, -1, 1, 1), 0.1); },
+                 "polygon.d[1]");  // origin outside
+  expect_invalid([] { PaddedPolygon(square_rows(), Eigen::Vector4d(1, 1, 1, kNan), 0.1); },
+                 "polygon.d[3]");
+  Eigen::MatrixX2d with_nan = square_rows();
+  with_nan(2, 1) = kNan;
+  expect_invalid([&] { PaddedPolygon(with_nan, Eigen::Vector4d(1, 1, 1, 1), 0.1); }, "polygon.C[2][1]");
+  expect_invalid([] { PaddedPolygon(square_rows(), Eigen::Vector4d(1, 1, 1, 1), -0.1); },
+                 "polygon.radius");
+  // Unbounded: three rows whose normals lie in a half-plane, and a strip.
+  Eigen::MatrixX2d open(3, 2);
+  open << 1, 0, 1, 1, 1, -1;
+  expect_invalid([&] { PaddedPolygon(open, Eigen::Vector3d(1, 1, 1), 0.1); }, "polygon.C");
+  Eigen::MatrixX2d strip(4, 2);
+  strip << 0, 1, 0, -1, 0, 2, 0, -2;
+  expect_invalid([&] { PaddedPolygon(strip, Eigen::Vector4d(1, 1, 1, 1), 0.1); }, "polygon.C");
+}
+
+}  // namespace
+}  // namespace diffpills
