@@ -48,7 +48,8 @@ int run_scene_demo(std::ostream& out) {
   print_vector(out, "dphi/dq1", result.gradient.segment<4>(3));
   print_vector(out, "dphi/dr2", result.gradient.segment<3>(7));
   print_vector(out, "dphi/dq2", result.gradient.segment<4>(10));
-  print_vector(out, "dphi/dtheta1 (body)", attitude_gradient(capsule_pose.q(), result.gradient.segment<4>(3)));
+  print_vector(out, "dphi/dtheta1 (body)",
+               attitude_gradient(capsule_pose.q(), result.gradient.segment<4>(3)));
   return 0;
 }
 

@@ -100,7 +100,9 @@ json rows(const Eigen::MatrixXd& matrix) {
   return out;
 }
 
-json list(const Eigen::VectorXd& v) { return json(std::vector<double>(v.data(), v.data() + v.size())); }
+json list(const Eigen::VectorXd& v) {
+  return json(std::vector<double>(v.data(), v.data() + v.size()));
+}
 
 }  // namespace
 

@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   if (argc == 2 && std::strcmp(argv[1], "demo") == 0) {
     return diffpills::app::run_scene_demo(std::cout);
   }
-  std::cerr << "diffpills: " << (argc < 2 ? "missing command" : "unknown arguments")
-            << "\n\n" << kHelp;
+  std::cerr << "diffpills: " << (argc < 2 ? "missing command" : "unknown arguments") << "\n\n"
+            << kHelp;
   return 2;
 }

@@ -29,7 +29,8 @@ json answer(const json& query) {
   const PosedShape b = parse_posed_shape(query["b"], "b");
   bool jacobian = false;
   if (query.contains("jacobian")) {
-    if (!query["jacobian"].is_boolean()) throw std::invalid_argument("jacobian: must be true or false");
+    if (!query["jacobian"].is_boolean())
+      throw std::invalid_argument("jacobian: must be true or false");
     jacobian = query["jacobian"].get<bool>();
   }
   ProximityOptions options;
@@ -53,13 +54,21 @@ json answer(const json& query) {
 
 std::string answer_query_line(const std::string& line, bool& ok) {
   ok = false;
+  json query;
   try {
-    const json query = json::parse(line);
+    query = json::parse(line);
+  } catch (const json::exception& error) {
+    // Syntax errors, and numbers JSON allows but a double cannot hold (1e999). NaN and Infinity
+    // are not JSON at all, so a non-finite value can only arrive as one of these.
+    return json{{"error", std::string("malformed JSON (numbers must be finite; NaN and Infinity "
+                                      "are not JSON): ") +
+                              error.what()}}
+        .dump();
+  }
+  try {
     json result = answer(query);
     ok = true;
     return result.dump();
-  } catch (const json::parse_error& error) {
-    return json{{"error", std::string("malformed JSON: ") + error.what()}}.dump();
   } catch (const std::exception& error) {
     return json{{"error", error.what()}}.dump();
   }

@@ -32,8 +32,9 @@ Eigen::Matrix<double, 3, 4> rotation_jacobian_signed(const Eigen::Vector4d& q,
   const Eigen::Vector3d v = unit.tail<3>();
   Eigen::Matrix<double, 3, 4> d_unit;
   d_unit.col(0) = 2.0 * s * v.cross(u);
-  d_unit.rightCols<3>() = -2.0 * s * w * skew(u) + 2.0 * (v.dot(u) * Eigen::Matrix3d::Identity() +
-                                                          v * u.transpose() - 2.0 * u * v.transpose());
+  d_unit.rightCols<3>() =
+      -2.0 * s * w * skew(u) +
+      2.0 * (v.dot(u) * Eigen::Matrix3d::Identity() + v * u.transpose() - 2.0 * u * v.transpose());
   return d_unit * normalization_jacobian(q);
 }
 

@@ -1,6 +1,7 @@
+#include "diffpills/shapes.hpp"
+
 #include <string>
 
-#include "diffpills/shapes.hpp"
 #include "validation.hpp"
 
 namespace diffpills {

@@ -33,8 +33,8 @@ Outputs evaluate(const Shape& a, const Shape& b, const Vector14& x) {
   return out;
 }
 
-Eigen::Matrix<double, 13, 14> central_differences(const Shape& a, const Shape& b,
-                                                  const Vector14& x, const Vector14& steps) {
+Eigen::Matrix<double, 13, 14> central_differences(const Shape& a, const Shape& b, const Vector14& x,
+                                                  const Vector14& steps) {
   Eigen::Matrix<double, 13, 14> jacobian;
   for (int j = 0; j < 14; ++j) {
     Vector14 plus = x, minus = x;
@@ -71,8 +71,10 @@ TEST_P(Derivatives, GradientAndJacobiansMatchCentralDifferences) {
   const int cases = 1000;
   for (int i = 0; i < cases; ++i) {
     const double scale = std::pow(10.0, std::uniform_int_distribution<int>(-3, 3)(rng));
-    const TestShape a = type.polygon_a ? random_polygon(rng, scale) : random_capsule(rng, scale, 0.05);
-    const TestShape b = type.polygon_b ? random_polygon(rng, scale) : random_capsule(rng, scale, 0.05);
+    const TestShape a =
+        type.polygon_a ? random_polygon(rng, scale) : random_capsule(rng, scale, 0.05);
+    const TestShape b =
+        type.polygon_b ? random_polygon(rng, scale) : random_capsule(rng, scale, 0.05);
     const Pose pose_a = random_pose(rng, 1.5 * scale);
     const Pose pose_b = random_pose(rng, 1.5 * scale);
     const ProximityJacobian analytic = proximity_jacobian(a.shape, pose_a, b.shape, pose_b);
@@ -87,7 +89,8 @@ TEST_P(Derivatives, GradientAndJacobiansMatchCentralDifferences) {
     steps << Eigen::Vector3d::Constant(1e-6 * scale), Eigen::Vector4d::Constant(1e-6),
         Eigen::Vector3d::Constant(1e-6 * scale), Eigen::Vector4d::Constant(1e-6);
     const auto fd = dimensionless(central_differences(a.shape, b.shape, x, steps), scale);
-    const auto fd_half = dimensionless(central_differences(a.shape, b.shape, x, 0.5 * steps), scale);
+    const auto fd_half =
+        dimensionless(central_differences(a.shape, b.shape, x, 0.5 * steps), scale);
     if ((fd - fd_half).cwiseAbs().maxCoeff() > 1e-6) {
       ++kinks;  // an active set changes within the step: the derivative is one-sided there
       continue;
@@ -98,7 +101,8 @@ TEST_P(Derivatives, GradientAndJacobiansMatchCentralDifferences) {
     worst = std::max(worst, error);
     ++checked;
     ASSERT_LE(error, 1e-5) << type.name << " case " << i << "\nanalytic\n"
-                           << dimensionless(exact, scale) << "\nfinite differences\n" << fd;
+                           << dimensionless(exact, scale) << "\nfinite differences\n"
+                           << fd;
   }
   std::cout << "[derivatives] " << type.name << ": " << checked << " checked, " << kinks
             << " skipped at an active-set change, " << intersecting
@@ -164,7 +168,8 @@ TEST(Derivatives, EnvelopeGradientEqualsOptNetRoute) {
       const detail::PairProblem up = problem_at(plus), down = problem_at(minus);
       const Eigen::MatrixXd dP =
           (up.F.transpose() * up.F - down.F.transpose() * down.F) / (2 * step);
-      const Eigen::VectorXd dc = (up.F.transpose() * up.g - down.F.transpose() * down.g) / (2 * step);
+      const Eigen::VectorXd dc =
+          (up.F.transpose() * up.g - down.F.transpose() * down.g) / (2 * step);
       const double dgg = (up.g.squaredNorm() - down.g.squaredNorm()) / (2 * step);
       const double explicit_part = x.dot(dP * x) + 2.0 * dc.dot(x) + dgg;
       const double through_solver = (through.P.array() * dP.array()).sum() + through.c.dot(dc);
@@ -177,7 +182,8 @@ TEST(Derivatives, EnvelopeGradientEqualsOptNetRoute) {
     ASSERT_LE(error, 1e-6) << "ordering " << ordering << "\noptnet   " << optnet.transpose()
                            << "\nenvelope " << envelope.gradient.transpose();
   }
-  std::cout << "[optnet] " << checked << " pairs, max relative |optnet - envelope| " << worst << "\n";
+  std::cout << "[optnet] " << checked << " pairs, max relative |optnet - envelope| " << worst
+            << "\n";
   EXPECT_GT(checked, 200);
 }
 
@@ -196,7 +202,8 @@ TEST(Derivatives, AttitudeGradientMatchesBodyRotationDifferences) {
       const double step = 1e-6;
       const auto rotated = [&](const Pose& pose, double angle) {
         const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
-        const Eigen::Quaterniond turned = q * Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::Unit(j)));
+        const Eigen::Quaterniond turned =
+            q * Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::Unit(j)));
         return Pose(pose.r(), Eigen::Vector4d(turned.w(), turned.x(), turned.y(), turned.z()));
       };
       const double fd_a = (proximity(a.shape, rotated(pose_a, step), b.shape, pose_b).phi -

@@ -1,12 +1,12 @@
 // phi and the closest points against the brute-force reference (support/reference.hpp) on
 // random pairs of every ordering at scales 1e-3, 1 and 1e3, and capsule pairs against FCL.
+#include <fcl/geometry/shape/capsule.h>
+#include <fcl/narrowphase/distance.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fcl/geometry/shape/capsule.h>
-#include <fcl/narrowphase/distance.h>
 #include <iostream>
 
 #include "diffpills/diffpills.hpp"
@@ -53,25 +53,30 @@ void check_against_reference(const TestShape& a, const Pose& pose_a, const TestS
   const double radius_sum = radius_of(a.shape) + radius_of(b.shape);
   const long double reference_phi =
       reference.distance * reference.distance - static_cast<long double>(radius_sum) * radius_sum;
-  const double phi_error = std::abs(static_cast<double>(result.phi - reference_phi)) /
-                           std::max<double>(scale * scale, std::abs(static_cast<double>(reference_phi)));
+  const double phi_error =
+      std::abs(static_cast<double>(result.phi - reference_phi)) /
+      std::max<double>(scale * scale, std::abs(static_cast<double>(reference_phi)));
   const double distance = (result.core_points[0] - result.core_points[1]).norm();
   const double distance_error =
       std::abs(distance - static_cast<double>(reference.distance)) / scale;
   tally.phi = std::max(tally.phi, phi_error);
   tally.distance = std::max(tally.distance, distance_error);
   ++tally.pairs;
-  ASSERT_LE(phi_error, 1e-9) << "phi " << result.phi << " reference " << static_cast<double>(reference_phi);
+  ASSERT_LE(phi_error, 1e-9) << "phi " << result.phi << " reference "
+                             << static_cast<double>(reference_phi);
   ASSERT_LE(distance_error, 1e-9);
   ASSERT_TRUE(on_core(a, pose_a, result.core_points[0], 1e-9 * scale));
   ASSERT_TRUE(on_core(b, pose_b, result.core_points[1], 1e-9 * scale));
   ASSERT_NEAR(result.normal.norm(), 1.0, 1e-12);
-  ASSERT_LE((result.points[0] - (result.core_points[0] + radius_of(a.shape) * result.normal)).norm(),
-            1e-12 * (scale + result.core_points[0].norm()));
-  ASSERT_LE((result.points[1] - (result.core_points[1] - radius_of(b.shape) * result.normal)).norm(),
-            1e-12 * (scale + result.core_points[1].norm()));
+  ASSERT_LE(
+      (result.points[0] - (result.core_points[0] + radius_of(a.shape) * result.normal)).norm(),
+      1e-12 * (scale + result.core_points[0].norm()));
+  ASSERT_LE(
+      (result.points[1] - (result.core_points[1] - radius_of(b.shape) * result.normal)).norm(),
+      1e-12 * (scale + result.core_points[1].norm()));
   if (!result.cores_intersect) {
-    ASSERT_LE((result.normal - (result.core_points[1] - result.core_points[0]) / distance).norm(), 1e-9);
+    ASSERT_LE((result.normal - (result.core_points[1] - result.core_points[0]) / distance).norm(),
+              1e-9);
   }
   ASSERT_TRUE(result.gradient.allFinite());
 }
@@ -97,8 +102,8 @@ void run_random_pairs(const ProximityOptions& options, int per_ordering_and_scal
           return;
         }
       }
-      std::cout << "[reference] " << label << " " << ((ordering & 2) ? "polygon" : "capsule")
-                << "-" << ((ordering & 1) ? "polygon" : "capsule") << " scale " << scale << ": "
+      std::cout << "[reference] " << label << " " << ((ordering & 2) ? "polygon" : "capsule") << "-"
+                << ((ordering & 1) ? "polygon" : "capsule") << " scale " << scale << ": "
                 << tally.pairs << " pairs, max relative phi error " << tally.phi
                 << ", max distance error / scale " << tally.distance << "\n";
     }
@@ -117,8 +122,8 @@ TEST(ProximityReference, InteriorPointMethodAgreesWithBruteForce) {
 fcl::Transform3d fcl_transform(const Pose& pose) {
   const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
   fcl::Transform3d transform = fcl::Transform3d::Identity();
-  transform.linear() =
-      q.normalized().toRotationMatrix() * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  transform.linear() = q.normalized().toRotationMatrix() *
+                       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
   transform.translation() = pose.r();
   return transform;
 }

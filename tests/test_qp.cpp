@@ -69,8 +69,8 @@ TEST(InteriorPoint, SatisfiesKktOnThousandsOfRandomQps) {
     const Eigen::VectorXd slack = qp.h - qp.G * result.x;
     const double primal = std::max(0.0, -slack.minCoeff());
     const double dual = std::max(0.0, -result.lambda.minCoeff());
-    const double stationarity = (qp.P * result.x + qp.c + qp.G.transpose() * result.lambda)
-                                    .cwiseAbs().maxCoeff();
+    const double stationarity =
+        (qp.P * result.x + qp.c + qp.G.transpose() * result.lambda).cwiseAbs().maxCoeff();
     const double complementarity =
         (slack.cwiseMax(0.0).array() * result.lambda.array()).abs().maxCoeff();
     const double error = std::max({primal, dual, stationarity, complementarity}) / scale;
@@ -172,8 +172,8 @@ TEST(Backward, MatchesFiniteDifferencesOfResolvedQps) {
       }
     }
     if (active_rows.rows() > 0) {
-      degenerate = degenerate || Eigen::FullPivLU<Eigen::MatrixXd>(active_rows).rank() <
-                                     active_rows.rows();
+      degenerate =
+          degenerate || Eigen::FullPivLU<Eigen::MatrixXd>(active_rows).rank() < active_rows.rows();
     }
     if (degenerate) continue;
     const QpGradient gradient = backward(solver, w + result.x);
@@ -216,9 +216,8 @@ TEST(InteriorPoint, ReportsFailureInsteadOfLooping) {
   Eigen::MatrixXd G(2, 1);
   G << 1, -1;
   InteriorPointSolver solver;
-  const InteriorPointResult& infeasible =
-      solver.solve(Eigen::MatrixXd::Identity(1, 1), Eigen::VectorXd::Zero(1), G,
-                   Eigen::Vector2d(-1, -1));
+  const InteriorPointResult& infeasible = solver.solve(
+      Eigen::MatrixXd::Identity(1, 1), Eigen::VectorXd::Zero(1), G, Eigen::Vector2d(-1, -1));
   EXPECT_NE(infeasible.status, Status::kSolved);
   EXPECT_LE(infeasible.iterations, solver.settings().max_iterations);
   EXPECT_THROW(backward(solver, Eigen::VectorXd::Ones(1)), std::logic_error);

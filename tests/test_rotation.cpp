@@ -52,12 +52,15 @@ TEST(Rotation, JacobiansMatchCentralDifferences) {
   for (int i = 0; i < 1000; ++i) {
     const Eigen::Vector4d q = random_quaternion(rng);
     const Eigen::Vector3d v = random_vector(rng);
-    const auto rotate = [&](const Eigen::Vector4d& p) { return Eigen::Vector3d(rotation_matrix(p) * v); };
+    const auto rotate = [&](const Eigen::Vector4d& p) {
+      return Eigen::Vector3d(rotation_matrix(p) * v);
+    };
     const auto rotate_back = [&](const Eigen::Vector4d& p) {
       return Eigen::Vector3d(rotation_matrix(p).transpose() * v);
     };
     EXPECT_LE((rotate_jacobian(q, v) - differences(rotate, q)).cwiseAbs().maxCoeff(), 1e-8);
-    EXPECT_LE((rotate_transpose_jacobian(q, v) - differences(rotate_back, q)).cwiseAbs().maxCoeff(), 1e-8);
+    EXPECT_LE((rotate_transpose_jacobian(q, v) - differences(rotate_back, q)).cwiseAbs().maxCoeff(),
+              1e-8);
     // Normalization is built in: no sensitivity along q itself.
     EXPECT_LE((rotate_jacobian(q, v) * q).norm(), 1e-12 * v.norm());
   }
@@ -68,8 +71,8 @@ TEST(Rotation, LeftMultiplyAndAttitudeJacobian) {
   for (int i = 0; i < 500; ++i) {
     const Eigen::Vector4d q = random_quaternion(rng);
     const Eigen::Vector4d p = random_quaternion(rng);
-    const Eigen::Quaterniond product = Eigen::Quaterniond(q(0), q(1), q(2), q(3)) *
-                                       Eigen::Quaterniond(p(0), p(1), p(2), p(3));
+    const Eigen::Quaterniond product =
+        Eigen::Quaterniond(q(0), q(1), q(2), q(3)) * Eigen::Quaterniond(p(0), p(1), p(2), p(3));
     const Eigen::Vector4d expected(product.w(), product.x(), product.y(), product.z());
     EXPECT_LE((left_multiply_matrix(q) * p - expected).norm(), 1e-13);
     // dq/dtheta of q (x) [1, theta/2] is 1/2 G(q).

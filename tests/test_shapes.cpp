@@ -31,7 +31,8 @@ Eigen::MatrixX2d square_rows() {
 
 PaddedPolygon regular_polygon(int sides, double apothem, double radius) {
   Eigen::MatrixX2d C(sides, 2);
-  for (int i = 0; i < sides; ++i) C.row(i) << std::cos(2 * M_PI * i / sides), std::sin(2 * M_PI * i / sides);
+  for (int i = 0; i < sides; ++i)
+    C.row(i) << std::cos(2 * M_PI * i / sides), std::sin(2 * M_PI * i / sides);
   return PaddedPolygon(C, Eigen::VectorXd::Constant(sides, apothem), radius);
 }
 
@@ -130,7 +131,8 @@ TEST(Shapes, PolygonRejectsBadRows) {
                  "polygon.d[3]");
   Eigen::MatrixX2d with_nan = square_rows();
   with_nan(2, 1) = kNan;
-  expect_invalid([&] { PaddedPolygon(with_nan, Eigen::Vector4d(1, 1, 1, 1), 0.1); }, "polygon.C[2][1]");
+  expect_invalid([&] { PaddedPolygon(with_nan, Eigen::Vector4d(1, 1, 1, 1), 0.1); },
+                 "polygon.C[2][1]");
   expect_invalid([] { PaddedPolygon(square_rows(), Eigen::Vector4d(1, 1, 1, 1), -0.1); },
                  "polygon.radius");
   // Unbounded: three rows whose normals lie in a half-plane, and a strip.

@@ -52,11 +52,13 @@ TEST(Symmetry, RigidMotionOfBothShapesMovesTheResultsWithThem) {
   std::normal_distribution<double> normal;
   for (int i = 0; i < 4000; ++i) {
     const RandomPair p = random_pair(rng, i % 4);
-    const Eigen::Quaterniond motion = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+    const Eigen::Quaterniond motion =
+        Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
     const Eigen::Matrix3d R = motion.toRotationMatrix();
     const Eigen::Vector3d t = p.scale * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
     const auto moved = [&](const Pose& pose) {
-      const Eigen::Quaterniond q = motion * Eigen::Quaterniond(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
+      const Eigen::Quaterniond q =
+          motion * Eigen::Quaterniond(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
       return Pose(R * pose.r() + t, Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()));
     };
     const Proximity before = proximity(p.a.shape, p.pose_a, p.b.shape, p.pose_b);
@@ -91,7 +93,9 @@ TEST(Symmetry, NonUnitQuaternionsEqualTheUnitOnes) {
     ASSERT_LE((reference.gradient.segment<3>(0) - scaled.gradient.segment<3>(0)).norm(), 1e-9 * s);
     if (!reference.cores_intersect) {
       ASSERT_LE((reference.core_points_jacobian.middleCols<4>(3) -
-                 k * scaled.core_points_jacobian.middleCols<4>(3)).cwiseAbs().maxCoeff(),
+                 k * scaled.core_points_jacobian.middleCols<4>(3))
+                    .cwiseAbs()
+                    .maxCoeff(),
                 1e-7 * s);
     }
     // At a unit quaternion the gradient has no component along q (normalization is built in).
@@ -104,8 +108,8 @@ TEST(Symmetry, InteriorPointAndAppendixAAgreeOnCapsulePairs) {
   for (int i = 0; i < 3000; ++i) {
     const RandomPair p = random_pair(rng, 0);
     const ProximityJacobian fast = proximity_jacobian(p.a.shape, p.pose_a, p.b.shape, p.pose_b);
-    const ProximityJacobian reference = proximity_jacobian(p.a.shape, p.pose_a, p.b.shape, p.pose_b,
-                                                           {Method::kInteriorPoint});
+    const ProximityJacobian reference =
+        proximity_jacobian(p.a.shape, p.pose_a, p.b.shape, p.pose_b, {Method::kInteriorPoint});
     const double s = p.scale;
     ASSERT_NEAR(fast.phi, reference.phi, 1e-9 * s * s);
     if (fast.cores_intersect) continue;

@@ -57,17 +57,20 @@ struct ProximityOptions {
 };
 
 struct Proximity {
-  double phi = 0.0;                         // |p1 - p2|^2 - (R1 + R2)^2
+  double phi = 0.0;                            // |p1 - p2|^2 - (R1 + R2)^2
   std::array<Eigen::Vector3d, 2> core_points;  // p1 on core 1, p2 on core 2, world frame
   std::array<Eigen::Vector3d, 2> points;       // surface points p1 + R1 n, p2 - R2 n, world frame
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, world frame, from shape 1 to shape 2
-  bool cores_intersect = false;             // p1 = p2: the normal is the documented fallback
-  Eigen::Matrix<double, 14, 1> gradient = Eigen::Matrix<double, 14, 1>::Zero();  // dphi/d[r1 q1 r2 q2]
+  bool cores_intersect = false;  // p1 = p2: the normal is the documented fallback
+  Eigen::Matrix<double, 14, 1> gradient =
+      Eigen::Matrix<double, 14, 1>::Zero();  // dphi/d[r1 q1 r2 q2]
 };
 
 struct ProximityJacobian : Proximity {
-  Eigen::Matrix<double, 6, 14> core_points_jacobian = Eigen::Matrix<double, 6, 14>::Zero();  // d[p1; p2]
-  Eigen::Matrix<double, 6, 14> points_jacobian = Eigen::Matrix<double, 6, 14>::Zero();       // d[p~1; p~2]
+  Eigen::Matrix<double, 6, 14> core_points_jacobian =
+      Eigen::Matrix<double, 6, 14>::Zero();  // d[p1; p2]
+  Eigen::Matrix<double, 6, 14> points_jacobian =
+      Eigen::Matrix<double, 6, 14>::Zero();  // d[p~1; p~2]
 };
 
 // Thrown when the QP solver does not converge (never silently wrong).

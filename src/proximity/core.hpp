@@ -19,7 +19,7 @@
 namespace diffpills::detail {
 
 struct Core {
-  int dim = 0;                                                  // 0, 1 or 2 parameters
+  int dim = 0;                                                          // 0, 1 or 2 parameters
   Eigen::Matrix<double, 3, 2> U = Eigen::Matrix<double, 3, 2>::Zero();  // first dim columns used
   Eigen::Vector3d u0 = Eigen::Vector3d::Zero();
   Eigen::MatrixXd G;  // constraint rows, dim columns

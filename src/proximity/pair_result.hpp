@@ -9,7 +9,6 @@
 namespace diffpills::detail {
 
 Proximity make_proximity(const PairProblem& problem, const PairSolution& solution);
-ProximityJacobian make_proximity_jacobian(const PairProblem& problem,
-                                          const PairSolution& solution);
+ProximityJacobian make_proximity_jacobian(const PairProblem& problem, const PairSolution& solution);
 
 }  // namespace diffpills::detail

@@ -31,8 +31,8 @@ PairSolution solve_pair(const PairProblem& problem, Method method) {
   const qp::InteriorPointResult& result = solver.solve(P, c, problem.G, problem.h);
   if (result.status != qp::Status::kSolved) {
     throw SolverError(std::string("diffpills: the interior-point method stopped with status ") +
-                      qp::to_string(result.status) + " after " +
-                      std::to_string(result.iterations) + " iterations");
+                      qp::to_string(result.status) + " after " + std::to_string(result.iterations) +
+                      " iterations");
   }
   solution.x = result.x;
   solution.lambda = result.lambda;

@@ -9,9 +9,10 @@
 namespace diffpills::detail {
 
 struct PairSolution {
-  Eigen::VectorXd x;       // the core parameters [x1; x2]
-  Eigen::VectorXd lambda;  // multipliers of G x <= h (dimensionless, for the scaled cost 1/2|Fx+g|^2)
-  int iterations = 0;      // interior-point iterations; 0 for closed-form solves
+  Eigen::VectorXd x;  // the core parameters [x1; x2]
+  Eigen::VectorXd
+      lambda;          // multipliers of G x <= h (dimensionless, for the scaled cost 1/2|Fx+g|^2)
+  int iterations = 0;  // interior-point iterations; 0 for closed-form solves
 };
 
 // Method::kDefault: two segments go to the Appendix A box solver (exact, closed form); every other

@@ -1,7 +1,6 @@
 #include "diffpills/qp/box_active_set.hpp"
 
 #include <Eigen/LU>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -50,7 +49,14 @@ BoxQpResult solve_box_qp(const Eigen::Matrix2d& P, const Eigen::Vector2d& c) {
     return result;
   }
   if (invertible) {
-    const Eigen::Vector2d unconstrained = -P.inverse() * c;  // Algorithm 1, line 2
+    // Algorithm 1, line 2, plus one step of iterative refinement: near the parallel threshold
+    // det P = P11 P22 - P12^2 cancels to a relative accuracy of eps / (det / P11 P22), and the
+    // resulting error in x lies along x itself, not along P's weak direction, so it shows in the
+    // cost (measured: 4e-12 relative at an angle of 1e-5 rad). The residual -c - P x is computed
+    // accurately, and one correction with the same inverse squares the relative error away.
+    const Eigen::Matrix2d inverse = P.inverse();
+    Eigen::Vector2d unconstrained = -inverse * c;
+    unconstrained += inverse * (-c - P * unconstrained);
     if ((unconstrained.array() >= 0.0).all() && (unconstrained.array() <= 1.0).all()) {
       result.x = unconstrained;
       result.lambda.setZero();
@@ -90,8 +96,9 @@ BoxQpResult solve_box_qp(const Eigen::Matrix2d& P, const Eigen::Vector2d& c) {
     // The optimal set is a segment along P's null direction (for P = F'F with parallel columns
     // f1, f2 it is n = [|f2|, -sign(P12) |f1|]), each end on a side or a corner, so both ends are
     // among the candidates whose cost ties the best. Return the middle of those ties along n.
-    const Eigen::Vector2d null_direction(std::sqrt(std::max(P(1, 1), 0.0)),
-                                         -std::copysign(std::sqrt(std::max(P(0, 0), 0.0)), P(0, 1)));
+    const Eigen::Vector2d null_direction(
+        std::sqrt(std::max(P(1, 1), 0.0)),
+        -std::copysign(std::sqrt(std::max(P(0, 0), 0.0)), P(0, 1)));
     const double tie = 1e-12 * (scale + std::abs(costs[best]));
     Eigen::Vector2d low = result.x;
     Eigen::Vector2d high = result.x;

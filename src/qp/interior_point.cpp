@@ -9,7 +9,9 @@
 namespace diffpills::qp {
 namespace {
 
-double inf_norm(const Eigen::VectorXd& v) { return v.size() == 0 ? 0.0 : v.lpNorm<Eigen::Infinity>(); }
+double inf_norm(const Eigen::VectorXd& v) {
+  return v.size() == 0 ? 0.0 : v.lpNorm<Eigen::Infinity>();
+}
 
 void require_finite(const Eigen::MatrixXd& m, const char* name) {
   if (!m.allFinite()) {
@@ -210,8 +212,9 @@ const InteriorPointResult& InteriorPointSolver::solve(const Eigen::MatrixXd& P,
     // Predictor: the pure Newton (affine-scaling) direction, eq. (pdip:affine).
     solve_newton(-r_dual_, -(s_.array() * lambda_.array()).matrix(), -r_primal_, affine_);
     const double alpha_affine = step_to_boundary(affine_);
-    const double mu_affine = (s_ + alpha_affine * affine_.s).dot(lambda_ + alpha_affine * affine_.lambda) /
-                             static_cast<double>(m);
+    const double mu_affine =
+        (s_ + alpha_affine * affine_.s).dot(lambda_ + alpha_affine * affine_.lambda) /
+        static_cast<double>(m);
     const double sigma = std::pow(mu_affine / mu, 3);  // Mehrotra's centering heuristic
     // Corrector: centering plus the second-order term, eq. (pdip:cc), same factorization.
     const Eigen::VectorXd centering =

@@ -43,11 +43,12 @@ TestShape random_polygon(Rng& rng, double scale) {
   const double radius_of_circle = uniform(rng, 0.3, 1.0) * scale;
   const double stretch = uniform(rng, 0.4, 1.0);
   const double turn = uniform(rng, 0.0, M_PI);
-  Eigen::Matrix2d map = Eigen::Rotation2Dd(turn).toRotationMatrix() *
-                        Eigen::Vector2d(1.0, stretch).asDiagonal();
+  Eigen::Matrix2d map =
+      Eigen::Rotation2Dd(turn).toRotationMatrix() * Eigen::Vector2d(1.0, stretch).asDiagonal();
   std::vector<Eigen::Vector2d> vertices;
   for (double angle : angles) {
-    vertices.push_back(map * (radius_of_circle * Eigen::Vector2d(std::cos(angle), std::sin(angle))));
+    vertices.push_back(map *
+                       (radius_of_circle * Eigen::Vector2d(std::cos(angle), std::sin(angle))));
   }
   // Move a random interior point (a convex combination with weights bounded away from zero) to
   // the origin.
@@ -103,8 +104,7 @@ Pose random_pose(Rng& rng, double spread) {
 }
 
 WorldCore to_world(const TestShape& shape, const Pose& pose) {
-  const Eigen::Quaternion<long double> rotation(pose.q()(0), pose.q()(1), pose.q()(2),
-                                                pose.q()(3));
+  const Eigen::Quaternion<long double> rotation(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
   const Eigen::Matrix<long double, 3, 3> R = rotation.normalized().toRotationMatrix();
   WorldCore core;
   for (const auto& v : shape.body_vertices) {

@@ -93,8 +93,8 @@ class InteriorPointSolver {
   };
 
   bool factor(const Eigen::MatrixXd& P);
-  void solve_newton(const Eigen::VectorXd& v1, const Eigen::VectorXd& v2,
-                    const Eigen::VectorXd& v3, Direction& out) const;
+  void solve_newton(const Eigen::VectorXd& v1, const Eigen::VectorXd& v2, const Eigen::VectorXd& v3,
+                    Direction& out) const;
   double step_to_boundary(const Direction& direction) const;
   bool try_polish(const Eigen::MatrixXd& P, const Eigen::VectorXd& c, const Eigen::VectorXd& h);
   void update_residuals(const Eigen::MatrixXd& P, const Eigen::VectorXd& c,

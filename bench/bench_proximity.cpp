@@ -1,0 +1,160 @@
+// diffpills beside FCL 0.7 on the same random poses, per pair type (issue 3's scenes):
+//   capsule-capsule  lengths 1.2 and 0.8, radii 0.2 and 0.15
+//   capsule-hexagon  the first capsule against a padded regular hexagon, d = 0.6
+//   hexagon-hexagon  padded regular hexagons, d = 0.6 and 0.43
+// FCL gets the same cores (its capsule axis is body z, ours x; a hexagon is an FCL Convex with one
+// face) and computes a bare distance; diffpills computes phi, both closest points, the normal and
+// the 14-entry gradient, and for *_Jacobian both 6x14 Jacobians too.
+#include <benchmark/benchmark.h>
+#include <fcl/geometry/shape/capsule.h>
+#include <fcl/geometry/shape/convex.h>
+#include <fcl/narrowphase/distance.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "diffpills/diffpills.hpp"
+
+namespace {
+
+using namespace diffpills;
+
+constexpr int kPoses = 1024;
+
+struct Scene {
+  std::vector<Pose> a, b;
+};
+
+// Positions in [-1.5, 1.5]^3, uniformly random attitudes: a mix of near and far pairs.
+const Scene& scene() {
+  static const Scene poses = [] {
+    std::mt19937_64 rng(2026);
+    std::normal_distribution<double> normal;
+    std::uniform_real_distribution<double> box(-1.5, 1.5);
+    Scene s;
+    for (int i = 0; i < kPoses; ++i) {
+      for (auto* list : {&s.a, &s.b}) {
+        const Eigen::Vector4d q =
+            Eigen::Vector4d(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+        list->emplace_back(Eigen::Vector3d(box(rng), box(rng), box(rng)), q);
+      }
+    }
+    return s;
+  }();
+  return poses;
+}
+
+PaddedPolygon hexagon(double apothem, double radius) {
+  Eigen::MatrixX2d C(6, 2);
+  for (int i = 0; i < 6; ++i) C.row(i) << std::cos(M_PI / 3 * i), std::sin(M_PI / 3 * i);
+  return PaddedPolygon(C, Eigen::VectorXd::Constant(6, apothem), radius);
+}
+
+const Capsule kCapsuleA(1.2, 0.2), kCapsuleB(0.8, 0.15);
+const PaddedPolygon kHexagonA = hexagon(0.6, 0.1), kHexagonB = hexagon(0.43, 0.05);
+
+template <class A, class B>
+void run_proximity(benchmark::State& state, const A& a, const B& b, Method method) {
+  const Scene& s = scene();
+  const ProximityOptions options{method};
+  int i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(proximity(a, s.a[i], b, s.b[i], options));
+    i = (i + 1) % kPoses;
+  }
+}
+
+template <class A, class B>
+void run_jacobian(benchmark::State& state, const A& a, const B& b) {
+  const Scene& s = scene();
+  int i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(proximity_jacobian(a, s.a[i], b, s.b[i]));
+    i = (i + 1) % kPoses;
+  }
+}
+
+// FCL's transform of one of our poses; `capsule` adds the z-to-x axis change.
+fcl::Transform3d fcl_pose(const Pose& pose, bool capsule) {
+  const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
+  fcl::Transform3d t = fcl::Transform3d::Identity();
+  t.linear() = q.toRotationMatrix();
+  if (capsule)
+    t.linear() =
+        t.linear() * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  t.translation() = pose.r();
+  return t;
+}
+
+std::shared_ptr<fcl::Convexd> fcl_hexagon(const PaddedPolygon& polygon) {
+  auto vertices = std::make_shared<std::vector<fcl::Vector3d>>();
+  auto faces = std::make_shared<std::vector<int>>();
+  faces->push_back(static_cast<int>(polygon.vertices().rows()));
+  for (Eigen::Index i = 0; i < polygon.vertices().rows(); ++i) {
+    vertices->emplace_back(polygon.vertices()(i, 0), polygon.vertices()(i, 1), 0.0);
+    faces->push_back(static_cast<int>(i));
+  }
+  return std::make_shared<fcl::Convexd>(vertices, 1, faces);
+}
+
+void run_fcl(benchmark::State& state, const fcl::CollisionGeometryd& a, bool a_capsule,
+             const fcl::CollisionGeometryd& b, bool b_capsule) {
+  const Scene& s = scene();
+  std::vector<fcl::Transform3d> ta, tb;
+  for (int i = 0; i < kPoses; ++i) {
+    ta.push_back(fcl_pose(s.a[i], a_capsule));
+    tb.push_back(fcl_pose(s.b[i], b_capsule));
+  }
+  const fcl::DistanceRequestd request;
+  int i = 0;
+  for (auto _ : state) {
+    fcl::DistanceResultd result;
+    benchmark::DoNotOptimize(fcl::distance(&a, ta[i], &b, tb[i], request, result));
+    i = (i + 1) % kPoses;
+  }
+}
+
+void CapsuleCapsule_Proximity(benchmark::State& s) {
+  run_proximity(s, kCapsuleA, kCapsuleB, Method::kDefault);
+}
+void CapsuleCapsule_InteriorPoint(benchmark::State& s) {
+  run_proximity(s, kCapsuleA, kCapsuleB, Method::kInteriorPoint);
+}
+void CapsuleCapsule_Jacobian(benchmark::State& s) { run_jacobian(s, kCapsuleA, kCapsuleB); }
+void CapsuleCapsule_FclDistance(benchmark::State& s) {
+  const fcl::Capsuled a(0.2, 1.2), b(0.15, 0.8);
+  run_fcl(s, a, true, b, true);
+}
+void CapsuleHexagon_Proximity(benchmark::State& s) {
+  run_proximity(s, kCapsuleA, kHexagonA, Method::kDefault);
+}
+void CapsuleHexagon_Jacobian(benchmark::State& s) { run_jacobian(s, kCapsuleA, kHexagonA); }
+void CapsuleHexagon_FclDistance(benchmark::State& s) {
+  const fcl::Capsuled a(0.2, 1.2);
+  run_fcl(s, a, true, *fcl_hexagon(kHexagonA), false);
+}
+void HexagonHexagon_Proximity(benchmark::State& s) {
+  run_proximity(s, kHexagonA, kHexagonB, Method::kDefault);
+}
+void HexagonHexagon_Jacobian(benchmark::State& s) { run_jacobian(s, kHexagonA, kHexagonB); }
+void HexagonHexagon_FclDistance(benchmark::State& s) {
+  run_fcl(s, *fcl_hexagon(kHexagonA), false, *fcl_hexagon(kHexagonB), false);
+}
+
+BENCHMARK(CapsuleCapsule_FclDistance);
+BENCHMARK(CapsuleCapsule_Proximity);
+BENCHMARK(CapsuleCapsule_InteriorPoint);
+BENCHMARK(CapsuleCapsule_Jacobian);
+BENCHMARK(CapsuleHexagon_FclDistance);
+BENCHMARK(CapsuleHexagon_Proximity);
+BENCHMARK(CapsuleHexagon_Jacobian);
+BENCHMARK(HexagonHexagon_FclDistance);
+BENCHMARK(HexagonHexagon_Proximity);
+BENCHMARK(HexagonHexagon_Jacobian);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,265 @@
+// Every degenerate configuration of the core issue, each against an analytic answer: parallel,
+// anti-parallel and collinear capsules, zero lengths, crossing cores, identical shapes at one
+// pose, stacked and coplanar polygons, a capsule parallel to a polygon, extreme scales and the
+// parallel / non-parallel boundary. Every output must be finite.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "diffpills/diffpills.hpp"
+#include "support/random_shapes.hpp"
+#include "support/reference.hpp"
+
+namespace diffpills::testing {
+namespace {
+
+const Eigen::Vector4d kIdentity(1, 0, 0, 0);
+
+// Rotation by `angle` about the unit axis (x, y, z).
+Eigen::Vector4d about(double angle, double x, double y, double z) {
+  return {std::cos(angle / 2), std::sin(angle / 2) * x, std::sin(angle / 2) * y,
+          std::sin(angle / 2) * z};
+}
+
+PaddedPolygon square(double half, double radius) {
+  Eigen::MatrixX2d C(4, 2);
+  C << 1, 0, 0, 1, -1, 0, 0, -1;
+  return PaddedPolygon(C, Eigen::VectorXd::Constant(4, half), radius);
+}
+
+template <class A, class B>
+ProximityJacobian query(const A& a, const Pose& pa, const B& b, const Pose& pb) {
+  const ProximityJacobian result = proximity_jacobian(a, pa, b, pb);
+  EXPECT_TRUE(std::isfinite(result.phi));
+  EXPECT_TRUE(result.gradient.allFinite());
+  EXPECT_TRUE(result.core_points_jacobian.allFinite());
+  EXPECT_TRUE(result.points_jacobian.allFinite());
+  EXPECT_TRUE(result.normal.allFinite());
+  EXPECT_NEAR(result.normal.norm(), 1.0, 1e-12);
+  return result;
+}
+
+// Central differences of phi along the 14 pose coordinates.
+template <class A, class B>
+Eigen::Matrix<double, 14, 1> phi_differences(const A& a, const Pose& pa, const B& b, const Pose& pb,
+                                             double step) {
+  Eigen::Matrix<double, 14, 1> x, out;
+  x << pa.r(), pa.q(), pb.r(), pb.q();
+  for (int j = 0; j < 14; ++j) {
+    auto at = [&](double e) {
+      Eigen::Matrix<double, 14, 1> y = x;
+      y(j) += e;
+      return proximity(a, Pose(y.segment<3>(0), y.segment<4>(3)), b,
+                       Pose(y.segment<3>(7), y.segment<4>(10)))
+          .phi;
+    };
+    out(j) = (at(step) - at(-step)) / (2 * step);
+  }
+  return out;
+}
+
+// Two parallel segments of length 2, the second shifted by 0.5 along x and 1 up: the optimal set
+// is x in [-0.5, 1] on both; its midpoint 0.25 is returned. phi = 1 - (0.1 + 0.1)^2.
+TEST(Degenerate, ParallelCapsulesTakeTheMiddleOfTheOverlap) {
+  const Capsule a(2.0, 0.1), b(2.0, 0.1);
+  const Pose pa({0, 0, 0}, kIdentity), pb({0.5, 0, 1}, kIdentity);
+  const ProximityJacobian r = query(a, pa, b, pb);
+  EXPECT_NEAR(r.phi, 1.0 - 0.04, 1e-14);
+  EXPECT_LE((r.core_points[0] - Eigen::Vector3d(0.25, 0, 0)).norm(), 1e-14);
+  EXPECT_LE((r.core_points[1] - Eigen::Vector3d(0.25, 0, 1)).norm(), 1e-14);
+  EXPECT_LE((r.normal - Eigen::Vector3d::UnitZ()).norm(), 1e-14);
+  // The midpoint choice makes the gradient equal the central difference even across the kink in
+  // rotation (the average of the two one-sided derivatives). Across a kink the central difference
+  // errs by O(step) (measured 3.5e-6 at step 1e-6), hence the small step.
+  EXPECT_LE((r.gradient - phi_differences(a, pa, b, pb, 1e-8)).cwiseAbs().maxCoeff(), 1e-6);
+  // Sliding the second segment keeps it parallel; the midpoint moves at half the rate.
+  const ProximityJacobian slid = query(a, pa, b, Pose({0.6, 0, 1}, kIdentity));
+  EXPECT_NEAR(slid.core_points[0].x(), 0.3, 1e-14);
+}
+
+TEST(Degenerate, AntiParallelCapsulesMatchParallel) {
+  const Capsule a(2.0, 0.1), b(2.0, 0.1);
+  const ProximityJacobian r =
+      query(a, Pose({0, 0, 0}, kIdentity), b, Pose({0.5, 0, 1}, about(M_PI, 0, 0, 1)));
+  EXPECT_NEAR(r.phi, 0.96, 1e-14);
+  EXPECT_LE((r.core_points[0] - Eigen::Vector3d(0.25, 0, 0)).norm(), 1e-12);
+  EXPECT_LE((r.core_points[1] - Eigen::Vector3d(0.25, 0, 1)).norm(), 1e-12);
+}
+
+TEST(Degenerate, CollinearCapsules) {
+  const Capsule a(2.0, 0.1), b(2.0, 0.2);
+  // End to end with a gap of 1: the facing end points.
+  const ProximityJacobian apart =
+      query(a, Pose({0, 0, 0}, kIdentity), b, Pose({3, 0, 0}, kIdentity));
+  EXPECT_NEAR(apart.phi, 1.0 - 0.09, 1e-14);
+  EXPECT_LE((apart.core_points[0] - Eigen::Vector3d(1, 0, 0)).norm(), 1e-14);
+  EXPECT_LE((apart.core_points[1] - Eigen::Vector3d(2, 0, 0)).norm(), 1e-14);
+  EXPECT_LE((apart.points[0] - Eigen::Vector3d(1.1, 0, 0)).norm(), 1e-14);
+  EXPECT_LE((apart.points[1] - Eigen::Vector3d(1.8, 0, 0)).norm(), 1e-14);
+  // Overlapping on one line: the cores intersect and the normal falls back to r2 - r1.
+  const ProximityJacobian overlap =
+      query(a, Pose({0, 0, 0}, kIdentity), b, Pose({1, 0, 0}, kIdentity));
+  EXPECT_TRUE(overlap.cores_intersect);
+  EXPECT_NEAR(overlap.phi, -0.09, 1e-14);
+  EXPECT_LE((overlap.normal - Eigen::Vector3d::UnitX()).norm(), 1e-14);
+  EXPECT_TRUE(overlap.gradient.isZero(1e-14));
+}
+
+TEST(Degenerate, ZeroLengthCapsulesAreSpheres) {
+  const Capsule sphere_a(0.0, 0.3), sphere_b(0.0, 0.2), segment(2.0, 0.1);
+  const ProximityJacobian spheres =
+      query(sphere_a, Pose({0, 0, 0}, kIdentity), sphere_b, Pose({1, 2, 2}, kIdentity));
+  EXPECT_NEAR(spheres.phi, 9.0 - 0.25, 1e-14);
+  EXPECT_LE((spheres.normal - Eigen::Vector3d(1, 2, 2) / 3.0).norm(), 1e-15);
+  Eigen::Matrix<double, 14, 1> expected;  // d|r1 - r2|^2 = 2 (r1 - r2) . (dr1 - dr2), no q terms
+  expected << -2, -4, -4, 0, 0, 0, 0, 2, 4, 4, 0, 0, 0, 0;
+  EXPECT_LE((spheres.gradient - expected).cwiseAbs().maxCoeff(), 1e-14);
+  // A sphere beside a segment's end and above its middle.
+  const ProximityJacobian end = query(sphere_a, Pose({3, 0, 0}, kIdentity), segment, Pose());
+  EXPECT_NEAR(end.phi, 4.0 - 0.16, 1e-14);
+  const ProximityJacobian middle = query(segment, Pose(), sphere_a, Pose({0.3, 2, 0}, kIdentity));
+  EXPECT_NEAR(middle.phi, 4.0 - 0.16, 1e-14);
+  EXPECT_LE((middle.core_points[0] - Eigen::Vector3d(0.3, 0, 0)).norm(), 1e-14);
+  // A sphere above a polygon's face and beside its edge.
+  const PaddedPolygon plate = square(1.0, 0.05);
+  EXPECT_NEAR(query(sphere_a, Pose({0.2, 0.3, 2}, kIdentity), plate, Pose()).phi, 4.0 - 0.1225,
+              1e-13);
+  EXPECT_NEAR(query(plate, Pose(), sphere_a, Pose({3, 0.5, 0}, kIdentity)).phi, 4.0 - 0.1225,
+              1e-13);
+  // Two points at the same place: cores intersect, normal falls back to shape 1's body z.
+  const ProximityJacobian same = query(sphere_a, Pose({1, 1, 1}, about(M_PI / 2, 1, 0, 0)),
+                                       sphere_b, Pose({1, 1, 1}, kIdentity));
+  EXPECT_TRUE(same.cores_intersect);
+  EXPECT_LE((same.normal - Eigen::Vector3d(0, -1, 0)).norm(), 1e-14);  // R_x(90) z = -y
+}
+
+TEST(Degenerate, CrossingCores) {
+  const Capsule a(2.0, 0.1), b(2.0, 0.2);
+  const ProximityJacobian r =
+      query(a, Pose({0, 0, 0}, kIdentity), b, Pose({0, 0, 0.5}, about(M_PI / 2, 0, 0, 1)));
+  EXPECT_FALSE(r.cores_intersect);  // 0.5 apart: not crossing yet
+  const ProximityJacobian crossing =
+      query(a, Pose({0.3, 0, 0}, kIdentity), b, Pose({0, 0.2, 0}, about(M_PI / 2, 0, 0, 1)));
+  EXPECT_TRUE(crossing.cores_intersect);
+  EXPECT_NEAR(crossing.phi, -0.09, 1e-14);
+  EXPECT_LE((crossing.core_points[0] - Eigen::Vector3d(0, 0, 0)).norm(), 1e-14);
+  EXPECT_TRUE(crossing.gradient.isZero(1e-14));
+  EXPECT_LE((crossing.normal - Eigen::Vector3d(-0.3, 0.2, 0).normalized()).norm(), 1e-14);
+  // A segment piercing a polygon, and two polygons crossing each other.
+  const PaddedPolygon plate = square(1.0, 0.05);
+  const ProximityJacobian pierce =
+      query(plate, Pose(), a, Pose({0.2, 0.1, 0.3}, about(M_PI / 2, 0, 1, 0)));
+  EXPECT_TRUE(pierce.cores_intersect);
+  EXPECT_NEAR(pierce.phi, -0.0225, 1e-14);
+  EXPECT_LE((pierce.core_points[0] - Eigen::Vector3d(0.2, 0.1, 0)).norm(), 1e-9);
+  const ProximityJacobian cross =
+      query(plate, Pose(), plate, Pose({0.3, 0, 0.2}, about(M_PI / 2, 1, 0, 0)));
+  EXPECT_TRUE(cross.cores_intersect);
+  EXPECT_NEAR(cross.phi, -0.01, 1e-14);
+}
+
+TEST(Degenerate, IdenticalShapesAtTheSamePose) {
+  const Pose pose({1, 2, 3}, about(0.7, 0.6, 0.8, 0));
+  const Eigen::Vector3d body_z = rotation_matrix(pose.q()).col(2);
+  const Capsule capsule(1.5, 0.2);
+  const PaddedPolygon plate = square(0.5, 0.1);
+  for (const ProximityJacobian& r :
+       {query(capsule, pose, capsule, pose), query(plate, pose, plate, pose),
+        query(capsule, pose, plate, pose), query(plate, pose, capsule, pose)}) {
+    EXPECT_TRUE(r.cores_intersect);
+    EXPECT_LE((r.normal - body_z).norm(), 1e-14);
+    EXPECT_TRUE(r.gradient.isZero(1e-12));
+  }
+}
+
+// Parallel planes one apart, the squares' projections overlapping: every pair above each other
+// is closest. phi = 1 - (R1 + R2)^2, the points lie in both squares, p2 - p1 is vertical.
+TEST(Degenerate, StackedParallelPolygons) {
+  const PaddedPolygon a = square(1.0, 0.1), b = square(0.5, 0.2);
+  const Pose pa({0, 0, 0}, kIdentity), pb({0.7, -0.2, 1}, about(0.4, 0, 0, 1));
+  const ProximityJacobian r = query(a, pa, b, pb);
+  EXPECT_NEAR(r.phi, 1.0 - 0.09, 1e-12);
+  EXPECT_LE((r.core_points[1] - r.core_points[0] - Eigen::Vector3d::UnitZ()).norm(), 1e-9);
+  EXPECT_LE(r.core_points[0].head<2>().cwiseAbs().maxCoeff(), 1.0 + 1e-9);
+  // Translations keep the configuration degenerate: there phi is smooth and the gradient exact.
+  const Eigen::Matrix<double, 14, 1> fd = phi_differences(a, pa, b, pb, 1e-6);
+  for (int j : {0, 1, 2, 7, 8, 9}) EXPECT_NEAR(r.gradient(j), fd(j), 1e-7);
+}
+
+TEST(Degenerate, CoplanarPolygons) {
+  const PaddedPolygon a = square(1.0, 0.1), b = square(1.0, 0.1);
+  const ProximityJacobian apart = query(a, Pose(), b, Pose({3, 0.5, 0}, kIdentity));
+  EXPECT_NEAR(apart.phi, 1.0 - 0.04, 1e-12);
+  EXPECT_NEAR(apart.core_points[0].x(), 1.0, 1e-9);
+  EXPECT_NEAR(apart.core_points[1].x(), 2.0, 1e-9);
+  EXPECT_LE((apart.normal - Eigen::Vector3d::UnitX()).norm(), 1e-9);
+  const ProximityJacobian overlap = query(a, Pose(), b, Pose({1, 0.5, 0}, about(0.3, 0, 0, 1)));
+  EXPECT_TRUE(overlap.cores_intersect);
+  EXPECT_NEAR(overlap.phi, -0.04, 1e-14);
+}
+
+TEST(Degenerate, CapsuleParallelToPolygonPlane) {
+  const Capsule capsule(4.0, 0.1);
+  const PaddedPolygon plate = square(1.0, 0.2);
+  const Pose capsule_pose({0.2, 0.4, 1.5}, about(0.3, 0, 0, 1));
+  const ProximityJacobian r = query(capsule, capsule_pose, plate, Pose());
+  EXPECT_NEAR(r.phi, 2.25 - 0.09, 1e-12);
+  EXPECT_LE((r.core_points[0] - r.core_points[1] - Eigen::Vector3d(0, 0, 1.5)).norm(), 1e-9);
+  EXPECT_LE(r.core_points[1].head<2>().cwiseAbs().maxCoeff(), 1.0 + 1e-9);
+  const ProximityJacobian swapped = query(plate, Pose(), capsule, capsule_pose);
+  EXPECT_NEAR(swapped.phi, r.phi, 1e-12);
+  const Eigen::Matrix<double, 14, 1> fd =
+      phi_differences(capsule, capsule_pose, plate, Pose(), 1e-6);
+  for (int j : {0, 1, 2, 7, 8, 9}) EXPECT_NEAR(r.gradient(j), fd(j), 1e-7);
+}
+
+// Two capsules turned by `angle` about the common perpendicular, at every scale: phi against the
+// brute force and continuous through angle 0. A fixed absolute parallel threshold such as
+// DiffPills.jl's 1e-4 would take angle 1e-3 at scale 1e-3 (det ~ 1e-12) for parallel; the
+// relative test does not, and the answer stays exact.
+TEST(Degenerate, ParallelBoundaryIsContinuousAtEveryScale) {
+  for (double scale : {1e-3, 1.0, 1e3}) {
+    const Capsule a(2.0 * scale, 0.1 * scale), b(1.5 * scale, 0.1 * scale);
+    const Pose pa({0, 0, 0}, kIdentity);
+    const Proximity parallel = proximity(a, pa, b, Pose({0.4 * scale, 0, scale}, kIdentity));
+    for (double angle : {1e-12, 1e-9, 1e-7, 1e-5, 1e-3, 1e-1}) {
+      for (double sign : {-1.0, 1.0}) {
+        const Pose pb({0.4 * scale, 0, scale}, about(sign * angle, 0, 0, 1));
+        const Proximity r = proximity(a, pa, b, pb);
+        TestShape ta{a, {Eigen::Vector3d(-scale, 0, 0), Eigen::Vector3d(scale, 0, 0)}, scale};
+        TestShape tb{
+            b, {Eigen::Vector3d(-0.75 * scale, 0, 0), Eigen::Vector3d(0.75 * scale, 0, 0)}, scale};
+        const long double d = brute_force_closest(to_world(ta, pa), to_world(tb, pb)).distance;
+        const double expected = static_cast<double>(d * d) - 0.04 * scale * scale;
+        EXPECT_NEAR(r.phi, expected, 1e-12 * scale * scale)
+            << "scale " << scale << " angle " << angle;
+        // The planes z = 0 and z = scale stay parallel: phi stays at its parallel value.
+        EXPECT_NEAR(r.phi, parallel.phi, 1e-12 * scale * scale);
+      }
+    }
+    // Tilted out of parallel within the plane of both segments: phi drops smoothly to zero
+    // separation at the crossing angle, never jumps.
+    double previous = parallel.phi;
+    for (double tilt = 1e-6; tilt < 0.2; tilt *= 2) {
+      const Proximity r = proximity(a, pa, b, Pose({0.4 * scale, 0, scale}, about(tilt, 0, 1, 0)));
+      EXPECT_LE(r.phi, previous + 1e-12 * scale * scale);
+      EXPECT_GE(r.phi, previous - 4.0 * tilt * scale * scale);  // Lipschitz in the angle
+      previous = r.phi;
+    }
+  }
+}
+
+TEST(Degenerate, ExtremeScalesWithMixedSizes) {
+  // A tiny capsule against a huge polygon, far from the origin, both orders.
+  const Capsule tiny(1e-3, 1e-4);
+  const PaddedPolygon huge = square(1e3, 1.0);
+  const Pose tiny_pose({500, -200, 3}, about(0.3, 1, 0, 0));
+  const ProximityJacobian r = query(tiny, tiny_pose, huge, Pose({0, 0, 0}, kIdentity));
+  const double lowest_z = 3.0 - 0.5e-3 * std::sin(0.0);  // the segment lies along x: z constant
+  EXPECT_NEAR(std::sqrt(r.phi + std::pow(1.0 + 1e-4, 2)), lowest_z, 1e-9);
+  const ProximityJacobian s = query(huge, Pose(), tiny, tiny_pose);
+  EXPECT_NEAR(s.phi, r.phi, 1e-9);
+}
+
+}  // namespace
+}  // namespace diffpills::testing
