@@ -74,7 +74,7 @@ BoxQpResult solve_box_qp(const Eigen::Matrix2d& P, const Eigen::Vector2d& c) {
       Eigen::Vector2d x;
       x(fixed) = value;
       x(free) = minimize_on_unit_interval(P(free, free), P(free, fixed) * value + c(free), scale);
-      candidates[static_cast<std::size_t>(2 * fixed + side)] = x;
+      candidates[2 * static_cast<std::size_t>(fixed) + static_cast<std::size_t>(side)] = x;
     }
   }
   candidates[4] = {0.0, 0.0};
