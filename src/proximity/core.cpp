@@ -10,7 +10,6 @@ Core make_core(const Capsule& capsule) {
     return core;  // a sphere: the core is the body origin
   }
   core.dim = 1;
-  core.is_segment = true;
   core.U(0, 0) = capsule.length();
   core.u0(0) = -0.5 * capsule.length();
   core.G.resize(2, 1);

@@ -26,7 +26,6 @@ struct Core {
   Eigen::VectorXd h;
   double radius = 0.0;
   double size = 0.0;  // length scale: the capsule's length or the polygon's extent
-  bool is_segment = false;
 };
 
 Core make_core(const Capsule& capsule);

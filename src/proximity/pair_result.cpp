@@ -1,8 +1,7 @@
 #include "pair_result.hpp"
 
-#include <Eigen/QR>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <vector>
 
 #include "diffpills/rotation.hpp"
 
@@ -11,34 +10,32 @@ namespace {
 
 using Matrix3x14 = Eigen::Matrix<double, 3, 14>;
 
-// d p_i / d[r1 q1 r2 q2] with the core parameters x held fixed: p_i = r_i + Q(q_i) u_i, so
-// dp_i/dr_i = I and dp_i/dq_i = d(Q(q_i) u_i)/dq_i, in shape i's seven columns.
-Matrix3x14 fixed_parameter_jacobian(const PairProblem& problem, int i, const Eigen::VectorXd& x) {
+// d p / d[r1 q1 r2 q2] with the body point u held fixed: p = r + Q(q) u, so dp/dr = I and
+// dp/dq = d(Q(q) u)/dq, in the shape's seven columns (column offset 0 or 7).
+Matrix3x14 fixed_point_jacobian(const PosedCore& core, const CoreSolution& solution, int column) {
   Matrix3x14 jacobian = Matrix3x14::Zero();
-  const int column = 7 * i;
   jacobian.block<3, 3>(0, column).setIdentity();
-  jacobian.block<3, 4>(0, column + 3) =
-      rotate_jacobian(problem.q[static_cast<std::size_t>(i)], problem.body_point(i, x));
+  jacobian.block<3, 4>(0, column + 3) = rotate_jacobian(core.q, solution.body_point);
   return jacobian;
 }
 
 // Below this distance the cores count as intersecting. Rounding in p1 - p2 is of order
 // eps * max(|p1|, |p2|, core size), so the threshold is relative to the same quantities.
-double intersection_tolerance(const PairProblem& problem, const Eigen::Vector3d& p1,
+double intersection_tolerance(const PosedCore& a, const PosedCore& b, const Eigen::Vector3d& p1,
                               const Eigen::Vector3d& p2) {
-  return 1e-12 * std::max({std::max(problem.cores[0]->size, problem.cores[1]->size),
-                           p1.lpNorm<Eigen::Infinity>(), p2.lpNorm<Eigen::Infinity>()});
+  return 1e-12 *
+         std::max({a.size, b.size, p1.lpNorm<Eigen::Infinity>(), p2.lpNorm<Eigen::Infinity>()});
 }
 
 enum class NormalRule { kClosestPoints, kOrigins, kBodyAxis };
 
 // The normal's rule (see proximity.hpp): the closest-point direction while the cores are apart;
 // otherwise the direction between the body origins, or shape 1's body z axis if those coincide.
-NormalRule normal_rule(const PairProblem& problem, const Eigen::Vector3d& p1,
+NormalRule normal_rule(const PosedCore& a, const PosedCore& b, const Eigen::Vector3d& p1,
                        const Eigen::Vector3d& p2) {
-  const double tolerance = intersection_tolerance(problem, p1, p2);
+  const double tolerance = intersection_tolerance(a, b, p1, p2);
   if ((p2 - p1).norm() > tolerance) return NormalRule::kClosestPoints;
-  if ((problem.r[1] - problem.r[0]).norm() > tolerance) return NormalRule::kOrigins;
+  if ((b.r - a.r).norm() > tolerance) return NormalRule::kOrigins;
   return NormalRule::kBodyAxis;
 }
 
@@ -48,120 +45,121 @@ Eigen::Matrix3d unit_vector_jacobian(const Eigen::Vector3d& v) {
   return (Eigen::Matrix3d::Identity() - n * n.transpose()) / v.norm();
 }
 
-// Implicit function theorem on the KKT conditions of the scaled pair QP (paper section II-C):
-// with e^ = F x + g and the active rows A = {j : lambda_j > 0},
-//   stationarity  F'e^ + G_A' lambda_A = 0,   activity  G_A x = h_A.
-// Differentiating in a pose coordinate xi (G, h do not depend on poses):
-//   [ F'F  G_A' ] [ dx       ]   [ -(F' de^/dxi|_x + dF'/dxi e^) ]
-//   [ G_A  0    ] [ dlambda_A ] = [ 0                             ]
-// where de^/dxi|_x = (dp1/dxi - dp2/dxi)|_x / s and, since F' = [U1'Q1'; -U2'Q2'] / s,
-//   dF'/dq_i e^ = +-U_i' d(Q_i' e^)/dq_i / s   (+ for core 1, - for core 2).
-// The system is solved by a complete orthogonal decomposition: where the minimizer is not unique
-// the matrix is singular and the minimum-norm solution is returned (see proximity.hpp).
-Eigen::MatrixXd parameter_jacobian(const PairProblem& problem, const PairSolution& solution,
-                                   const Matrix3x14& difference_jacobian,
-                                   const Eigen::Vector3d& difference) {
-  const int n = problem.n();
-  const double s = problem.scale;
-  const Eigen::Vector3d scaled_difference = difference / s;
-  Eigen::MatrixXd rhs_top = -(problem.F.transpose() * difference_jacobian) / s;
-  int row = 0;
-  for (int i = 0; i < 2; ++i) {
-    const Core& core = *problem.cores[static_cast<std::size_t>(i)];
-    const double sign = i == 0 ? 1.0 : -1.0;
-    rhs_top.block(row, 7 * i + 3, core.dim, 4) -=
-        sign / s * core.U.leftCols(core.dim).transpose() *
-        rotate_transpose_jacobian(problem.q[static_cast<std::size_t>(i)], scaled_difference);
-    row += core.dim;
+using FreeMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 4>;
+using ReducedRhs = Eigen::Matrix<double, Eigen::Dynamic, 14, 0, 4, 14>;
+
+// Implicit function theorem with the active set eliminated (core_solution.hpp). Near the
+// solution p_i = r_i + Q_i (u_i + D_i xi_i), and the free coordinates xi = (xi1, xi2) minimize
+// |e|^2, e = p1 - p2, without constraints. With M = [Q1 D1, -Q2 D2] stationarity is M'e = 0;
+// differentiating in a pose coordinate at the solution (xi = 0),
+//   M'M dxi = -(M' de/dpose|_xi + dM'/dpose e),
+//   de/dpose|_xi = dp1|_u - dp2|_u,   dM'/dq_i e = +-D_i' d(Q_i' e)/dq_i   (+ core 1, - core 2).
+// M'M is at most 4 x 4. Where the closest points are not unique (parallel features) it is
+// singular; the pseudo-inverse then gives the minimum-norm motion, with eigenvalues below 1e-12
+// of the largest treated as zero, the same relative threshold as the parallel test of the box
+// solver (sin^2 of the angle between features).
+void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCore& b,
+                      const CoreSolution& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
+                      Matrix3x14& dp2) {
+  const int z1 = sa.free_dimensions;
+  const int z2 = sb.free_dimensions;
+  const int z = z1 + z2;
+  if (z == 0) return;
+  FreeMatrix M(3, z);
+  M.leftCols(z1) = a.rotation * sa.free_directions.leftCols(z1);
+  M.rightCols(z2) = -b.rotation * sb.free_directions.leftCols(z2);
+  ReducedRhs rhs = -M.transpose() * (dp1 - dp2);
+  rhs.block(0, 3, z1, 4) -=
+      sa.free_directions.leftCols(z1).transpose() * rotate_transpose_jacobian(a.q, difference);
+  rhs.block(z1, 10, z2, 4) +=
+      sb.free_directions.leftCols(z2).transpose() * rotate_transpose_jacobian(b.q, difference);
+  // The eigen-decomposition runs on a fixed 4 x 4 matrix: the z x z Hessian padded with a
+  // diagonal block of its mean eigenvalue, which leaves the Hessian's own eigenpairs untouched.
+  Eigen::Matrix4d padded = Eigen::Matrix4d::Zero();
+  padded.topLeftCorner(z, z) = M.transpose() * M;
+  const double mean = padded.trace() / z;
+  for (int k = z; k < 4; ++k) padded(k, k) = mean;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(padded);
+  const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
+  Eigen::Matrix4d pseudo_inverse = Eigen::Matrix4d::Zero();
+  for (int k = 0; k < 4; ++k) {
+    const double value = eigen.eigenvalues()(k);
+    if (value > 1e-12 * largest) {
+      pseudo_inverse +=
+          eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() / value;
+    }
   }
-  std::vector<Eigen::Index> active;
-  for (Eigen::Index j = 0; j < solution.lambda.size(); ++j) {
-    if (solution.lambda(j) > 0.0) active.push_back(j);
-  }
-  const auto k = static_cast<Eigen::Index>(active.size());
-  Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(n + k, n + k);
-  kkt.topLeftCorner(n, n) = problem.F.transpose() * problem.F;
-  for (Eigen::Index j = 0; j < k; ++j) {
-    const Eigen::Index constraint = active[static_cast<std::size_t>(j)];
-    kkt.block(n + j, 0, 1, n) = problem.G.row(constraint);
-    kkt.block(0, n + j, n, 1) = problem.G.row(constraint).transpose();
-  }
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n + k, 14);
-  rhs.topRows(n) = rhs_top;
-  return kkt.completeOrthogonalDecomposition().solve(rhs).topRows(n);
+  const ReducedRhs dxi = pseudo_inverse.topLeftCorner(z, z) * rhs;
+  dp1 += M.leftCols(z1) * dxi.topRows(z1);
+  dp2 -= M.rightCols(z2) * dxi.bottomRows(z2);  // M's right block carries the minus sign
 }
 
 }  // namespace
 
-Proximity make_proximity(const PairProblem& problem, const PairSolution& solution) {
+Proximity make_proximity(const PosedCore& a, const CoreSolution& solution_a, const PosedCore& b,
+                         const CoreSolution& solution_b) {
   Proximity result;
-  const Eigen::Vector3d p1 = problem.world_point(0, solution.x);
-  const Eigen::Vector3d p2 = problem.world_point(1, solution.x);
-  const double radius_sum = problem.cores[0]->radius + problem.cores[1]->radius;
+  const Eigen::Vector3d p1 = a.r + a.rotation * solution_a.body_point;
+  const Eigen::Vector3d p2 = b.r + b.rotation * solution_b.body_point;
   const Eigen::Vector3d difference = p1 - p2;
+  const double radius_sum = a.radius + b.radius;
   result.phi = difference.squaredNorm() - radius_sum * radius_sum;  // eq. caps_prox
   result.core_points = {p1, p2};
-  // Envelope theorem: d phi = 2 (p1 - p2)' (dp1 - dp2) at fixed x*.
-  const Matrix3x14 difference_jacobian = fixed_parameter_jacobian(problem, 0, solution.x) -
-                                         fixed_parameter_jacobian(problem, 1, solution.x);
-  result.gradient = 2.0 * difference_jacobian.transpose() * difference;
+  // Envelope theorem: d phi = 2 (p1 - p2)' (dp1 - dp2) with the body points held fixed.
+  result.gradient.segment<3>(0) = 2.0 * difference;
+  result.gradient.segment<4>(3) =
+      2.0 * rotate_jacobian(a.q, solution_a.body_point).transpose() * difference;
+  result.gradient.segment<3>(7) = -2.0 * difference;
+  result.gradient.segment<4>(10) =
+      -2.0 * rotate_jacobian(b.q, solution_b.body_point).transpose() * difference;
 
-  switch (normal_rule(problem, p1, p2)) {
+  switch (normal_rule(a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
       result.normal = (p2 - p1).normalized();
       break;
     case NormalRule::kOrigins:
       result.cores_intersect = true;
-      result.normal = (problem.r[1] - problem.r[0]).normalized();
+      result.normal = (b.r - a.r).normalized();
       break;
     case NormalRule::kBodyAxis:
       result.cores_intersect = true;
-      result.normal = problem.rotation[0].col(2);
+      result.normal = a.rotation.col(2);
       break;
   }
-  // eqs. caps_c_1, caps_c_2
-  result.points = {p1 + problem.cores[0]->radius * result.normal,
-                   p2 - problem.cores[1]->radius * result.normal};
+  result.points = {p1 + a.radius * result.normal, p2 - b.radius * result.normal};  // caps_c_1/2
   return result;
 }
 
-ProximityJacobian make_proximity_jacobian(const PairProblem& problem,
-                                          const PairSolution& solution) {
+ProximityJacobian make_proximity_jacobian(const PosedCore& a, const CoreSolution& solution_a,
+                                          const PosedCore& b, const CoreSolution& solution_b) {
   ProximityJacobian result;
-  static_cast<Proximity&>(result) = make_proximity(problem, solution);
+  static_cast<Proximity&>(result) = make_proximity(a, solution_a, b, solution_b);
   const Eigen::Vector3d& p1 = result.core_points[0];
   const Eigen::Vector3d& p2 = result.core_points[1];
 
-  // dp_i = dp_i|_x + Q_i U_i dx_i.
-  Matrix3x14 dp1 = fixed_parameter_jacobian(problem, 0, solution.x);
-  Matrix3x14 dp2 = fixed_parameter_jacobian(problem, 1, solution.x);
-  if (problem.n() > 0) {
-    const Eigen::MatrixXd dx = parameter_jacobian(problem, solution, dp1 - dp2, p1 - p2);
-    const Core& core1 = *problem.cores[0];
-    const Core& core2 = *problem.cores[1];
-    dp1 += problem.rotation[0] * core1.U.leftCols(core1.dim) * dx.topRows(core1.dim);
-    dp2 += problem.rotation[1] * core2.U.leftCols(core2.dim) * dx.bottomRows(core2.dim);
-  }
+  Matrix3x14 dp1 = fixed_point_jacobian(a, solution_a, 0);
+  Matrix3x14 dp2 = fixed_point_jacobian(b, solution_b, 7);
+  add_point_motion(a, solution_a, b, solution_b, p1 - p2, dp1, dp2);
   result.core_points_jacobian.topRows<3>() = dp1;
   result.core_points_jacobian.bottomRows<3>() = dp2;
 
   Matrix3x14 dnormal = Matrix3x14::Zero();
-  switch (normal_rule(problem, p1, p2)) {
+  switch (normal_rule(a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
       dnormal = unit_vector_jacobian(p2 - p1) * (dp2 - dp1);
       break;
     case NormalRule::kOrigins: {
-      const Eigen::Matrix3d d_unit = unit_vector_jacobian(problem.r[1] - problem.r[0]);
+      const Eigen::Matrix3d d_unit = unit_vector_jacobian(b.r - a.r);
       dnormal.block<3, 3>(0, 0) = -d_unit;
       dnormal.block<3, 3>(0, 7) = d_unit;
       break;
     }
     case NormalRule::kBodyAxis:
-      dnormal.block<3, 4>(0, 3) = rotate_jacobian(problem.q[0], Eigen::Vector3d::UnitZ());
+      dnormal.block<3, 4>(0, 3) = rotate_jacobian(a.q, Eigen::Vector3d::UnitZ());
       break;
   }
-  result.points_jacobian.topRows<3>() = dp1 + problem.cores[0]->radius * dnormal;
-  result.points_jacobian.bottomRows<3>() = dp2 - problem.cores[1]->radius * dnormal;
+  result.points_jacobian.topRows<3>() = dp1 + a.radius * dnormal;
+  result.points_jacobian.bottomRows<3>() = dp2 - b.radius * dnormal;
   return result;
 }
 

@@ -2,30 +2,19 @@
 
 #include <string>
 
-#include "diffpills/qp/box_active_set.hpp"
 #include "diffpills/qp/interior_point.hpp"
 
 namespace diffpills::detail {
 
-PairSolution solve_pair(const PairProblem& problem, Method method) {
+PairSolution solve_pair(const PairProblem& problem) {
   PairSolution solution;
   const int n = problem.n();
   if (n == 0) {
     return solution;
   }
+  // The paper's P = F'F, c = F'g (eqs. caps_qp_cost, polygon_qp_cost, polygon_caps_qp_cost).
   const Eigen::MatrixXd P = problem.F.transpose() * problem.F;
   const Eigen::VectorXd c = problem.F.transpose() * problem.g;
-
-  const bool two_segments = problem.cores[0]->is_segment && problem.cores[1]->is_segment;
-  if (two_segments && method == Method::kDefault) {
-    const qp::BoxQpResult box = qp::solve_box_qp(P, c);
-    solution.x = box.x;
-    // The box solver orders its multipliers [x1 <= 1, x2 <= 1, -x1 <= 0, -x2 <= 0]; the pair's
-    // G = blkdiag([1; -1], [1; -1]) orders them [x1 <= 1, -x1 <= 0, x2 <= 1, -x2 <= 0].
-    solution.lambda.resize(4);
-    solution.lambda << box.lambda(0), box.lambda(2), box.lambda(1), box.lambda(3);
-    return solution;
-  }
 
   qp::InteriorPointSolver solver;
   const qp::InteriorPointResult& result = solver.solve(P, c, problem.G, problem.h);
@@ -43,8 +32,39 @@ PairSolution solve_pair(const PairProblem& problem, Method method) {
       if (result.lambda(i) <= result.s(i)) solution.lambda(i) = 0.0;
     }
   }
-  solution.iterations = result.iterations;
   return solution;
+}
+
+std::array<CoreSolution, 2> core_solutions(const PairProblem& problem,
+                                           const PairSolution& solution) {
+  std::array<CoreSolution, 2> sides;
+  Eigen::Index row = 0;
+  for (int i = 0; i < 2; ++i) {
+    const Core& core = *problem.cores[static_cast<std::size_t>(i)];
+    CoreSolution& side = sides[static_cast<std::size_t>(i)];
+    side.body_point = problem.body_point(i, solution.x);
+    int active = 0;
+    Eigen::Index last_active = 0;
+    for (Eigen::Index j = 0; j < core.G.rows(); ++j) {
+      if (solution.lambda(row + j) > 0.0) {
+        ++active;
+        last_active = j;
+      }
+    }
+    row += core.G.rows();
+    if (core.dim == 1 && active == 0) {
+      side.free_dimensions = 1;
+      side.free_directions.col(0) = Eigen::Vector3d::UnitX();
+    } else if (core.dim == 2 && active == 0) {
+      side.free_dimensions = 2;
+      side.free_directions.col(0) = Eigen::Vector3d::UnitX();
+      side.free_directions.col(1) = Eigen::Vector3d::UnitY();
+    } else if (core.dim == 2 && active == 1) {
+      side.free_dimensions = 1;
+      side.free_directions.col(0) << -core.G(last_active, 1), core.G(last_active, 0), 0.0;
+    }
+  }
+  return sides;
 }
 
 }  // namespace diffpills::detail

@@ -1,23 +1,29 @@
-// Solving the pair QP (pair_problem.hpp) with the method the caller chose.
+// Solving the pair QP (pair_problem.hpp) with the general solvers: the reference path.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 
+#include "core_solution.hpp"
 #include "diffpills/proximity.hpp"
 #include "pair_problem.hpp"
 
 namespace diffpills::detail {
 
 struct PairSolution {
-  Eigen::VectorXd x;  // the core parameters [x1; x2]
-  Eigen::VectorXd
-      lambda;          // multipliers of G x <= h (dimensionless, for the scaled cost 1/2|Fx+g|^2)
-  int iterations = 0;  // interior-point iterations; 0 for closed-form solves
+  Eigen::VectorXd x;       // the core parameters [x1; x2]
+  Eigen::VectorXd lambda;  // multipliers of G x <= h; positive exactly on the active rows
 };
 
-// Method::kDefault: two segments go to the Appendix A box solver (exact, closed form); every other
-// pair, and Method::kInteriorPoint, to the interior-point method with polish. A pair without
-// parameters (two spheres) needs no solve. Throws SolverError if the interior point method fails.
-PairSolution solve_pair(const PairProblem& problem, Method method);
+// The interior-point method with polish (qp/interior_point.hpp). A pair without parameters (two
+// spheres) needs no solve. Throws SolverError if the method fails.
+PairSolution solve_pair(const PairProblem& problem);
+
+// The two sides of a solution in the form the result builder takes: each core's body point, and
+// the body directions its active rows leave free (a segment: its axis unless a bound is active;
+// a polygon: the face plane with no active row, the row's edge tangent with one, none with two,
+// which with non-redundant rows means a vertex).
+std::array<CoreSolution, 2> core_solutions(const PairProblem& problem,
+                                           const PairSolution& solution);
 
 }  // namespace diffpills::detail

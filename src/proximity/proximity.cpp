@@ -1,11 +1,15 @@
-// The public queries: every ordering of the two shapes goes through the same pipeline,
-// core parameterization -> pair QP -> solve -> results (see pair_problem.hpp).
+// The public queries. Method::kDefault sends each pair to its exact fast solver (fast_paths.hpp);
+// Method::kInteriorPoint builds the pair's QP (pair_problem.hpp) and solves it with the paper's
+// interior-point method. Both hand the two sides of the solution to the same result builder.
 #include "diffpills/proximity.hpp"
 
 #include <type_traits>
+#include <utility>
 #include <variant>
 
 #include "core.hpp"
+#include "core_solution.hpp"
+#include "fast_paths.hpp"
 #include "pair_problem.hpp"
 #include "pair_result.hpp"
 #include "pair_solve.hpp"
@@ -13,18 +17,47 @@
 namespace diffpills {
 namespace {
 
-// Result is Proximity or ProximityJacobian; the pipeline is the same up to the last step.
+using detail::CoreSolution;
+using detail::PosedCore;
+using Sides = std::array<CoreSolution, 2>;
+
+Sides fast_sides(const Capsule& a, const PosedCore& pa, const Capsule& b, const PosedCore& pb) {
+  return detail::solve_capsule_capsule(a, pa, b, pb);
+}
+Sides fast_sides(const Capsule& a, const PosedCore& pa, const PaddedPolygon& b,
+                 const PosedCore& pb) {
+  return detail::solve_capsule_polygon(a, pa, b, pb);
+}
+Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Capsule& b,
+                 const PosedCore& pb) {
+  const Sides swapped = detail::solve_capsule_polygon(b, pb, a, pa);
+  return {swapped[1], swapped[0]};
+}
+Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const PaddedPolygon& b,
+                 const PosedCore& pb) {
+  return detail::solve_polygon_polygon(a, pa, b, pb);
+}
+
+Sides reference_sides(const detail::Core& core_a, const Pose& pose_a, const detail::Core& core_b,
+                      const Pose& pose_b) {
+  const detail::PairProblem problem = detail::make_pair_problem(core_a, pose_a, core_b, pose_b);
+  return detail::core_solutions(problem, detail::solve_pair(problem));
+}
+
+// Result is Proximity or ProximityJacobian; everything but the last step is shared.
 template <class Result, class ShapeA, class ShapeB>
 Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& pose_b,
              const ProximityOptions& options) {
-  const detail::Core core_a = detail::make_core(a);
-  const detail::Core core_b = detail::make_core(b);
-  const detail::PairProblem problem = detail::make_pair_problem(core_a, pose_a, core_b, pose_b);
-  const detail::PairSolution solution = detail::solve_pair(problem, options.method);
+  const PosedCore posed_a = detail::posed_core(a, pose_a);
+  const PosedCore posed_b = detail::posed_core(b, pose_b);
+  const Sides sides =
+      options.method == Method::kInteriorPoint
+          ? reference_sides(detail::make_core(a), pose_a, detail::make_core(b), pose_b)
+          : fast_sides(a, posed_a, b, posed_b);
   if constexpr (std::is_same_v<Result, ProximityJacobian>) {
-    return detail::make_proximity_jacobian(problem, solution);
+    return detail::make_proximity_jacobian(posed_a, sides[0], posed_b, sides[1]);
   } else {
-    return detail::make_proximity(problem, solution);
+    return detail::make_proximity(posed_a, sides[0], posed_b, sides[1]);
   }
 }
 
