@@ -123,6 +123,12 @@ void CapsuleCapsule_Proximity(benchmark::State& s) {
 void CapsuleCapsule_InteriorPoint(benchmark::State& s) {
   run_proximity(s, kCapsuleA, kCapsuleB, Method::kInteriorPoint);
 }
+void CapsuleHexagon_InteriorPoint(benchmark::State& s) {
+  run_proximity(s, kCapsuleA, kHexagonA, Method::kInteriorPoint);
+}
+void HexagonHexagon_InteriorPoint(benchmark::State& s) {
+  run_proximity(s, kHexagonA, kHexagonB, Method::kInteriorPoint);
+}
 void CapsuleCapsule_Jacobian(benchmark::State& s) { run_jacobian(s, kCapsuleA, kCapsuleB); }
 void CapsuleCapsule_FclDistance(benchmark::State& s) {
   const fcl::Capsuled a(0.2, 1.2), b(0.15, 0.8);
@@ -144,15 +150,58 @@ void HexagonHexagon_FclDistance(benchmark::State& s) {
   run_fcl(s, *fcl_hexagon(kHexagonA), false, *fcl_hexagon(kHexagonB), false);
 }
 
+// proximity_batch over 10^5 pose pairs with 1 and 2 threads (wall-clock time).
+constexpr Eigen::Index kBatch = 100000;
+
+struct BatchPoses {
+  PositionArray r_a, r_b;
+  QuaternionArray q_a, q_b;
+};
+
+const BatchPoses& batch_poses() {
+  static const BatchPoses poses = [] {
+    BatchPoses p{PositionArray(kBatch, 3), PositionArray(kBatch, 3), QuaternionArray(kBatch, 4),
+                 QuaternionArray(kBatch, 4)};
+    const Scene& s = scene();
+    for (Eigen::Index i = 0; i < kBatch; ++i) {
+      const auto k = static_cast<std::size_t>(i % kPoses);
+      const auto m = static_cast<std::size_t>((i * 7 + 3) % kPoses);
+      p.r_a.row(i) = s.a[k].r().transpose();
+      p.q_a.row(i) = s.a[k].q().transpose();
+      p.r_b.row(i) = s.b[m].r().transpose();
+      p.q_b.row(i) = s.b[m].q().transpose();
+    }
+    return p;
+  }();
+  return poses;
+}
+
+void run_batch(benchmark::State& state, const Shape& a, const Shape& b) {
+  const BatchPoses& p = batch_poses();
+  const BatchOptions options{static_cast<int>(state.range(0))};
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(proximity_batch(a, p.r_a, p.q_a, b, p.r_b, p.q_b, options));
+  }
+  state.SetItemsProcessed(state.iterations() * kBatch);
+}
+
+void Batch_CapsuleCapsule(benchmark::State& s) { run_batch(s, kCapsuleA, kCapsuleB); }
+void Batch_HexagonHexagon(benchmark::State& s) { run_batch(s, kHexagonA, kHexagonB); }
+
+BENCHMARK(Batch_CapsuleCapsule)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(Batch_HexagonHexagon)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
 BENCHMARK(CapsuleCapsule_FclDistance);
 BENCHMARK(CapsuleCapsule_Proximity);
 BENCHMARK(CapsuleCapsule_InteriorPoint);
 BENCHMARK(CapsuleCapsule_Jacobian);
 BENCHMARK(CapsuleHexagon_FclDistance);
 BENCHMARK(CapsuleHexagon_Proximity);
+BENCHMARK(CapsuleHexagon_InteriorPoint);
 BENCHMARK(CapsuleHexagon_Jacobian);
 BENCHMARK(HexagonHexagon_FclDistance);
 BENCHMARK(HexagonHexagon_Proximity);
+BENCHMARK(HexagonHexagon_InteriorPoint);
 BENCHMARK(HexagonHexagon_Jacobian);
 
 }  // namespace

@@ -62,7 +62,7 @@ std::vector<DualPoint> convex_hull(std::vector<DualPoint> points) {
 
 PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d, double radius)
     : C_(C), d_(d), radius_(radius) {
-  detail::require_nonnegative(radius, "polygon.radius");
+  detail::require_nonnegative(radius, [] { return "polygon.radius"; });
   const Eigen::Index m = C.rows();
   if (m < 3) {
     detail::fail("polygon.C", "needs at least 3 rows (got " + std::to_string(m) + ")");
@@ -76,12 +76,12 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
   std::vector<Eigen::Vector2d> unit_normals(static_cast<std::size_t>(m));
   std::vector<double> unit_offsets(static_cast<std::size_t>(m));
   for (Eigen::Index i = 0; i < m; ++i) {
-    const std::string row = "[" + std::to_string(i) + "]";
-    detail::require_finite(C(i, 0), "polygon.C" + row + "[0]");
-    detail::require_finite(C(i, 1), "polygon.C" + row + "[1]");
-    detail::require_finite(d(i), "polygon.d" + row);
+    const auto row = [i] { return "[" + std::to_string(i) + "]"; };
+    detail::require_finite(C(i, 0), [&] { return "polygon.C" + row() + "[0]"; });
+    detail::require_finite(C(i, 1), [&] { return "polygon.C" + row() + "[1]"; });
+    detail::require_finite(d(i), [&] { return "polygon.d" + row(); });
     if (!(d(i) > 0.0)) {
-      detail::fail("polygon.d" + row,
+      detail::fail("polygon.d" + row(),
                    "must be > 0 so that the body origin lies strictly inside the polygon (got " +
                        std::to_string(d(i)) + ")");
     }

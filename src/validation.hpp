@@ -3,17 +3,43 @@
 // pass it on unchanged or prefix it with the shape's own name.
 #pragma once
 
+#include <cmath>
 #include <string>
+
+#include "diffpills/shapes.hpp"
 
 namespace diffpills::detail {
 
-// Throws unless value is finite and |value| <= kMaxMagnitude.
-void require_finite(double value, const std::string& field);
+// Throws unless value is finite and |value| <= kMaxMagnitude. The field's name is built only on
+// failure: `field` is called then, so valid input costs no string work (the batch API validates
+// every pose).
+template <class FieldName>
+void require_finite(double value, const FieldName& field);
 
 // Throws unless value is finite and 0 <= value <= kMaxMagnitude.
-void require_nonnegative(double value, const std::string& field);
+template <class FieldName>
+void require_nonnegative(double value, const FieldName& field);
+
+// The failure paths, out of line.
+[[noreturn]] void fail_finite(double value, const std::string& field);
+[[noreturn]] void fail_negative(double value, const std::string& field);
 
 // "field: problem (got value)".
 [[noreturn]] void fail(const std::string& field, const std::string& problem);
+
+template <class FieldName>
+void require_finite(double value, const FieldName& field) {
+  if (!(std::abs(value) <= kMaxMagnitude)) {  // false for NaN too
+    fail_finite(value, std::string(field()));
+  }
+}
+
+template <class FieldName>
+void require_nonnegative(double value, const FieldName& field) {
+  require_finite(value, field);
+  if (value < 0.0) {
+    fail_negative(value, std::string(field()));
+  }
+}
 
 }  // namespace diffpills::detail

@@ -2,6 +2,7 @@
 // The umbrella header; see each header for its part of the contract.
 #pragma once
 
+#include "diffpills/batch.hpp"
 #include "diffpills/proximity.hpp"
 #include "diffpills/qp/backward.hpp"
 #include "diffpills/qp/box_active_set.hpp"

@@ -17,16 +17,20 @@
 //
 // Degenerate cases, chosen on purpose:
 //   - Non-unique closest points (parallel segments, a segment parallel to a polygon's plane,
-//     stacked parallel polygons): phi is exact and continuous; the closest points are a
-//     documented choice. Capsule pairs take the midpoint of the optimal set (Appendix A solver);
-//     pairs with a polygon take the interior-point method's limit, the optimal point nearest its
-//     iterate, which tends to the analytic centre of the optimal set. Either choice moves
-//     continuously while the configuration stays degenerate. The closest points themselves jump
-//     when a configuration leaves the degenerate set (two nearly parallel segments touch near one
-//     end of their overlap, and which end flips with the sign of the angle); no choice avoids
-//     that. There the Jacobians are the minimum-norm solution of the singular KKT system.
-//   - Zero length capsules are spheres; parallelism thresholds are relative (1e-12 on sin^2 of
-//     the angle), so they mean the same at every scale.
+//     stacked parallel polygons, crossing cores): phi is exact and continuous; the closest points
+//     are the middle of the optimal set, the midpoint of an interval or the area centroid of a
+//     planar region (Method::kDefault). That choice moves continuously while the configuration
+//     stays degenerate. The reference path (Method::kInteriorPoint) returns the interior-point
+//     method's limit instead, the optimal point nearest its iterate, which tends to the analytic
+//     centre of the optimal set: the same set, so phi and the gradient's position part agree, but
+//     not always the same point in it. The closest points themselves jump when a configuration
+//     leaves the degenerate set (two nearly parallel segments touch near one end of their
+//     overlap, and which end flips with the sign of the angle); no choice avoids that. There the
+//     Jacobians are the minimum-norm solution of the singular system.
+//   - Parallelism thresholds are relative, so they mean the same at every scale: |sin| <= 1e-12
+//     between a segment and a segment, a plane or another plane (where the distance varies
+//     linearly with a tilt, so the middle of the optimal set stays within 1e-12 of optimal).
+//   - Zero length capsules are spheres.
 //   - Intersecting cores (|p1 - p2| <= 1e-12 of the scene's size): cores_intersect is true,
 //     phi = -(R1 + R2)^2 and its gradient is zero (the proximity is flat there: keep phi > 0 with
 //     a margin in optimizers). The normal is then undefined and replaced by a deterministic
@@ -48,8 +52,13 @@
 namespace diffpills {
 
 enum class Method {
-  kDefault,        // the fastest exact method for the pair (Appendix A for two capsules)
-  kInteriorPoint,  // the paper's interior-point method (section II-B) for every pair: the reference
+  // Exact fast paths: two segments in closed form (Appendix A's candidates), pairs with a polygon
+  // by enumerating feature pairs in a polygon's body frame. No heap allocation for polygons of up
+  // to 32 vertices.
+  kDefault,
+  // The paper's interior-point method (section II-B) on the pair's QP, polished to its active
+  // set: slower, kept as the reference the fast paths are tested against.
+  kInteriorPoint,
 };
 
 struct ProximityOptions {

@@ -17,6 +17,11 @@ Eigen::Matrix3d rotation_matrix(const Eigen::Vector4d& q);
 // d/dq [ Q(q / |q|) v ]  (3x4), for a fixed body-frame vector v.
 Eigen::Matrix<double, 3, 4> rotate_jacobian(const Eigen::Vector4d& q, const Eigen::Vector3d& v);
 
+// d/dq [ w . Q(q / |q|) v ]  (4-vector): w' rotate_jacobian(q, v) without forming the Jacobian,
+// which is all a gradient of a scalar needs (dphi/dq = 2 (p1 - p2)' dp1/dq).
+Eigen::Vector4d rotate_gradient(const Eigen::Vector4d& q, const Eigen::Vector3d& v,
+                                const Eigen::Vector3d& w);
+
 // d/dq [ Q(q / |q|)^T v ]  (3x4), for a fixed world-frame vector v.
 Eigen::Matrix<double, 3, 4> rotate_transpose_jacobian(const Eigen::Vector4d& q,
                                                       const Eigen::Vector3d& v);

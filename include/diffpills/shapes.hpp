@@ -27,8 +27,8 @@ class Capsule {
   double radius() const { return radius_; }
 
  private:
-  double length_;
-  double radius_;
+  double length_ = 0.0;
+  double radius_ = 0.0;
 };
 
 // A padded polygon: the core is {y in R^2 : C y <= d} in the body x-y plane, padded by the radius
@@ -64,7 +64,7 @@ class PaddedPolygon {
  private:
   Eigen::MatrixX2d C_;
   Eigen::VectorXd d_;
-  double radius_;
+  double radius_ = 0.0;
   Eigen::MatrixX2d normals_;
   Eigen::VectorXd offsets_;
   Eigen::MatrixX2d vertices_;

@@ -22,8 +22,8 @@ std::array<CoreSolution, 2> solve_capsule_polygon(const Capsule& capsule,
                                                   const PaddedPolygon& polygon,
                                                   const PosedCore& posed_polygon) {
   const double length = capsule.length();
-  const Eigen::Matrix3d& R = posed_polygon.rotation;
-  const Eigen::Vector3d axis = length * posed_capsule.rotation.col(0);
+  const Eigen::Matrix3d& R = posed_polygon.attitude.matrix();
+  const Eigen::Vector3d axis = length * posed_capsule.attitude.matrix().col(0);
   const Eigen::Vector3d p = R.transpose() * (posed_capsule.r - 0.5 * axis - posed_polygon.r);
   const Eigen::Vector3d u = R.transpose() * axis;
 

@@ -1,15 +1,21 @@
 #include "core_solution.hpp"
 
-#include "diffpills/rotation.hpp"
-
 namespace diffpills::detail {
 
+namespace {
+
+PosedCore make_posed_core(const Pose& pose, double radius, double size) {
+  return {pose.r(), UnitQuaternion(pose.q()), radius, size};
+}
+
+}  // namespace
+
 PosedCore posed_core(const Capsule& capsule, const Pose& pose) {
-  return {pose.r(), pose.q(), rotation_matrix(pose.q()), capsule.radius(), capsule.length()};
+  return make_posed_core(pose, capsule.radius(), capsule.length());
 }
 
 PosedCore posed_core(const PaddedPolygon& polygon, const Pose& pose) {
-  return {pose.r(), pose.q(), rotation_matrix(pose.q()), polygon.radius(), polygon.extent()};
+  return make_posed_core(pose, polygon.radius(), polygon.extent());
 }
 
 }  // namespace diffpills::detail

@@ -12,13 +12,13 @@
 #include <Eigen/Core>
 
 #include "diffpills/shapes.hpp"
+#include "unit_quaternion.hpp"
 
 namespace diffpills::detail {
 
 struct PosedCore {
   Eigen::Vector3d r;
-  Eigen::Vector4d q;  // as given (not necessarily unit): derivatives include the normalization
-  Eigen::Matrix3d rotation;
+  UnitQuaternion attitude;  // q normalized once, and Q(q); derivatives refer to q as given
   double radius = 0.0;
   double size = 0.0;  // the core's length scale, for relative tolerances
 };

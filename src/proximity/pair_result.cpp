@@ -1,9 +1,8 @@
 #include "pair_result.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
-
-#include "diffpills/rotation.hpp"
 
 namespace diffpills::detail {
 namespace {
@@ -15,7 +14,7 @@ using Matrix3x14 = Eigen::Matrix<double, 3, 14>;
 Matrix3x14 fixed_point_jacobian(const PosedCore& core, const CoreSolution& solution, int column) {
   Matrix3x14 jacobian = Matrix3x14::Zero();
   jacobian.block<3, 3>(0, column).setIdentity();
-  jacobian.block<3, 4>(0, column + 3) = rotate_jacobian(core.q, solution.body_point);
+  jacobian.block<3, 4>(0, column + 3) = core.attitude.rotate_jacobian(solution.body_point);
   return jacobian;
 }
 
@@ -45,53 +44,59 @@ Eigen::Matrix3d unit_vector_jacobian(const Eigen::Vector3d& v) {
   return (Eigen::Matrix3d::Identity() - n * n.transpose()) / v.norm();
 }
 
-using FreeMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 4>;
-using ReducedRhs = Eigen::Matrix<double, Eigen::Dynamic, 14, 0, 4, 14>;
-
 // Implicit function theorem with the active set eliminated (core_solution.hpp). Near the
 // solution p_i = r_i + Q_i (u_i + D_i xi_i), and the free coordinates xi = (xi1, xi2) minimize
 // |e|^2, e = p1 - p2, without constraints. With M = [Q1 D1, -Q2 D2] stationarity is M'e = 0;
 // differentiating in a pose coordinate at the solution (xi = 0),
 //   M'M dxi = -(M' de/dpose|_xi + dM'/dpose e),
 //   de/dpose|_xi = dp1|_u - dp2|_u,   dM'/dq_i e = +-D_i' d(Q_i' e)/dq_i   (+ core 1, - core 2).
-// M'M is at most 4 x 4. Where the closest points are not unique (parallel features) it is
-// singular; the pseudo-inverse then gives the minimum-norm motion, with eigenvalues below 1e-12
-// of the largest treated as zero, the same relative threshold as the parallel test of the box
-// solver (sin^2 of the angle between features).
+// Everything is fixed-size: each side's directions fill two columns of M (unused ones are zero),
+// and the unused diagonal entries of M'M are set to the mean of the used ones, which leaves the
+// solution for the used coordinates untouched and keeps the matrix invertible.
+// Where the closest points are not unique (parallel features) M'M is singular; the pseudo-inverse
+// then gives the minimum-norm motion, with eigenvalues below 1e-12 of the largest treated as zero,
+// the relative threshold of the parallel tests (sin^2 of the angle between features). The cheap
+// explicit inverse serves whenever det(M'M) / prod(diag) > 1e-12, which rules that out.
 void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCore& b,
                       const CoreSolution& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
                       Matrix3x14& dp2) {
   const int z1 = sa.free_dimensions;
   const int z2 = sb.free_dimensions;
-  const int z = z1 + z2;
-  if (z == 0) return;
-  FreeMatrix M(3, z);
-  M.leftCols(z1) = a.rotation * sa.free_directions.leftCols(z1);
-  M.rightCols(z2) = -b.rotation * sb.free_directions.leftCols(z2);
-  ReducedRhs rhs = -M.transpose() * (dp1 - dp2);
-  rhs.block(0, 3, z1, 4) -=
-      sa.free_directions.leftCols(z1).transpose() * rotate_transpose_jacobian(a.q, difference);
-  rhs.block(z1, 10, z2, 4) +=
-      sb.free_directions.leftCols(z2).transpose() * rotate_transpose_jacobian(b.q, difference);
-  // The eigen-decomposition runs on a fixed 4 x 4 matrix: the z x z Hessian padded with a
-  // diagonal block of its mean eigenvalue, which leaves the Hessian's own eigenpairs untouched.
-  Eigen::Matrix4d padded = Eigen::Matrix4d::Zero();
-  padded.topLeftCorner(z, z) = M.transpose() * M;
-  const double mean = padded.trace() / z;
-  for (int k = z; k < 4; ++k) padded(k, k) = mean;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(padded);
-  const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
-  Eigen::Matrix4d pseudo_inverse = Eigen::Matrix4d::Zero();
+  if (z1 + z2 == 0) return;
+  Eigen::Matrix<double, 3, 4> M;
+  M.leftCols<2>() = a.attitude.matrix() * sa.free_directions;
+  M.rightCols<2>() = -b.attitude.matrix() * sb.free_directions;
+  Eigen::Matrix<double, 4, 14> rhs = -M.transpose() * (dp1 - dp2);
+  rhs.block<2, 4>(0, 3) -=
+      sa.free_directions.transpose() * a.attitude.rotate_transpose_jacobian(difference);
+  rhs.block<2, 4>(2, 10) +=
+      sb.free_directions.transpose() * b.attitude.rotate_transpose_jacobian(difference);
+  Eigen::Matrix4d hessian = M.transpose() * M;
+  const bool used[4] = {z1 > 0, z1 > 1, z2 > 0, z2 > 1};
+  double mean = 0.0;
+  for (int k = 0; k < 4; ++k) mean += used[k] ? hessian(k, k) : 0.0;
+  mean /= z1 + z2;
   for (int k = 0; k < 4; ++k) {
-    const double value = eigen.eigenvalues()(k);
-    if (value > 1e-12 * largest) {
-      pseudo_inverse +=
-          eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() / value;
-    }
+    if (!used[k]) hessian(k, k) = mean;
   }
-  const ReducedRhs dxi = pseudo_inverse.topLeftCorner(z, z) * rhs;
-  dp1 += M.leftCols(z1) * dxi.topRows(z1);
-  dp2 -= M.rightCols(z2) * dxi.bottomRows(z2);  // M's right block carries the minus sign
+  Eigen::Matrix<double, 4, 14> dxi;
+  if (hessian.determinant() > 1e-12 * hessian.diagonal().prod()) {
+    dxi = hessian.inverse() * rhs;
+  } else {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(hessian);
+    const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
+    Eigen::Matrix4d pseudo_inverse = Eigen::Matrix4d::Zero();
+    for (int k = 0; k < 4; ++k) {
+      const double value = eigen.eigenvalues()(k);
+      if (value > 1e-12 * largest) {
+        pseudo_inverse +=
+            eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() / value;
+      }
+    }
+    dxi = pseudo_inverse * rhs;
+  }
+  dp1 += M.leftCols<2>() * dxi.topRows<2>();
+  dp2 -= M.rightCols<2>() * dxi.bottomRows<2>();  // M's right block carries the minus sign
 }
 
 }  // namespace
@@ -99,8 +104,8 @@ void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCor
 Proximity make_proximity(const PosedCore& a, const CoreSolution& solution_a, const PosedCore& b,
                          const CoreSolution& solution_b) {
   Proximity result;
-  const Eigen::Vector3d p1 = a.r + a.rotation * solution_a.body_point;
-  const Eigen::Vector3d p2 = b.r + b.rotation * solution_b.body_point;
+  const Eigen::Vector3d p1 = a.r + a.attitude.matrix() * solution_a.body_point;
+  const Eigen::Vector3d p2 = b.r + b.attitude.matrix() * solution_b.body_point;
   const Eigen::Vector3d difference = p1 - p2;
   const double radius_sum = a.radius + b.radius;
   result.phi = difference.squaredNorm() - radius_sum * radius_sum;  // eq. caps_prox
@@ -108,10 +113,10 @@ Proximity make_proximity(const PosedCore& a, const CoreSolution& solution_a, con
   // Envelope theorem: d phi = 2 (p1 - p2)' (dp1 - dp2) with the body points held fixed.
   result.gradient.segment<3>(0) = 2.0 * difference;
   result.gradient.segment<4>(3) =
-      2.0 * rotate_jacobian(a.q, solution_a.body_point).transpose() * difference;
+      2.0 * a.attitude.rotate_gradient(solution_a.body_point, difference);
   result.gradient.segment<3>(7) = -2.0 * difference;
   result.gradient.segment<4>(10) =
-      -2.0 * rotate_jacobian(b.q, solution_b.body_point).transpose() * difference;
+      -2.0 * b.attitude.rotate_gradient(solution_b.body_point, difference);
 
   switch (normal_rule(a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
@@ -123,7 +128,7 @@ Proximity make_proximity(const PosedCore& a, const CoreSolution& solution_a, con
       break;
     case NormalRule::kBodyAxis:
       result.cores_intersect = true;
-      result.normal = a.rotation.col(2);
+      result.normal = a.attitude.matrix().col(2);
       break;
   }
   result.points = {p1 + a.radius * result.normal, p2 - b.radius * result.normal};  // caps_c_1/2
@@ -155,7 +160,7 @@ ProximityJacobian make_proximity_jacobian(const PosedCore& a, const CoreSolution
       break;
     }
     case NormalRule::kBodyAxis:
-      dnormal.block<3, 4>(0, 3) = rotate_jacobian(a.q, Eigen::Vector3d::UnitZ());
+      dnormal.block<3, 4>(0, 3) = a.attitude.rotate_jacobian(Eigen::Vector3d::UnitZ());
       break;
   }
   result.points_jacobian.topRows<3>() = dp1 + a.radius * dnormal;

@@ -1,0 +1,37 @@
+// Many queries of one shape pair at once: the poses come as arrays, the work is split across
+// threads, and every entry equals the single call proximity(a, pose_a[i], b, pose_b[i]).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "diffpills/proximity.hpp"
+#include "diffpills/shapes.hpp"
+
+namespace diffpills {
+
+struct BatchOptions {
+  int threads = 0;  // worker threads; 0 = every hardware thread
+  Method method = Method::kDefault;
+};
+
+// Rows are poses: r is N x 3, q is N x 4 ([w x y z]), both row-major like NumPy's default.
+using PositionArray = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+using QuaternionArray = Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor>;
+using GradientArray = Eigen::Matrix<double, Eigen::Dynamic, 14, Eigen::RowMajor>;
+
+struct BatchResult {
+  Eigen::VectorXd phi;     // N
+  GradientArray gradient;  // N x 14, the layout of Proximity::gradient
+};
+
+// phi and the 14-entry gradient for pair i = (a at (r_a[i], q_a[i]), b at (r_b[i], q_b[i])).
+// Throws std::invalid_argument if the arrays differ in length or a pose is invalid; the message
+// names the first bad row, e.g. "q_b[17]: quaternion must be nonzero ...". The outputs are
+// allocated once; the per-pair work allocates nothing for polygons of up to 32 vertices.
+BatchResult proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
+                            const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
+                            const Eigen::Ref<const PositionArray>& r_b,
+                            const Eigen::Ref<const QuaternionArray>& q_b,
+                            const BatchOptions& options = {});
+
+}  // namespace diffpills
