@@ -1,6 +1,7 @@
 #include "diffpills/batch.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <exception>
 #include <mutex>
 #include <stdexcept>
@@ -32,11 +33,11 @@ Pose pose_at(const Eigen::Ref<const PositionArray>& r, const Eigen::Ref<const Qu
 
 }  // namespace
 
-BatchResult proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
-                            const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
-                            const Eigen::Ref<const PositionArray>& r_b,
-                            const Eigen::Ref<const QuaternionArray>& q_b,
-                            const BatchOptions& options) {
+void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
+                     const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
+                     const Eigen::Ref<const PositionArray>& r_b,
+                     const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> phi,
+                     Eigen::Ref<GradientArray> gradient, const BatchOptions& options) {
   const Eigen::Index n = r_a.rows();
   if (q_a.rows() != n || r_b.rows() != n || q_b.rows() != n) {
     throw std::invalid_argument(
@@ -48,46 +49,69 @@ BatchResult proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray
   if (options.threads < 0) {
     throw std::invalid_argument("threads: must be >= 0 (0 = every hardware thread)");
   }
-  BatchResult result;
-  result.phi.resize(n);
-  result.gradient.resize(n, 14);
+  if (phi.size() != n || gradient.rows() != n) {
+    throw std::invalid_argument("proximity_batch: phi and gradient must have one row per pose (" +
+                                std::to_string(n) + ")");
+  }
   const ProximityOptions single{options.method};
 
-  // Contiguous chunks, one per thread: no shared writes, no per-pair scheduling.
+  // Threads take blocks of kBlock rows from a shared counter: pair costs vary (a crossing pair
+  // of polygons stops early, a distant one prunes most edge pairs), and a fixed split into one
+  // chunk per thread left one thread idle while the other finished (1.79x on two threads instead
+  // of 1.8-1.9x). Each row is written by exactly one thread; nothing else is shared.
+  constexpr Eigen::Index kBlock = 512;
   const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-  const auto threads = static_cast<Eigen::Index>(std::min<Eigen::Index>(
-      std::max<Eigen::Index>(n, 1), options.threads == 0 ? hardware : options.threads));
+  const Eigen::Index blocks = (n + kBlock - 1) / kBlock;
+  const Eigen::Index threads = std::min<Eigen::Index>(
+      std::max<Eigen::Index>(blocks, 1), options.threads == 0 ? hardware : options.threads);
+  std::atomic<Eigen::Index> next_block{0};
   std::exception_ptr first_error;
-  Eigen::Index first_error_row = n;
+  std::atomic<Eigen::Index> first_error_row{n};
   std::mutex error_mutex;
-  const auto work = [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index i = begin; i < end; ++i) {
-      try {
-        const Proximity single_result =
-            proximity(a, pose_at(r_a, q_a, i, "a"), b, pose_at(r_b, q_b, i, "b"), single);
-        result.phi(i) = single_result.phi;
-        result.gradient.row(i) = single_result.gradient.transpose();
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(error_mutex);
-        if (i < first_error_row) {  // report the lowest bad row, whatever the thread timing
-          first_error_row = i;
-          first_error = std::current_exception();
+  const auto work = [&] {
+    for (Eigen::Index block = next_block++; block < blocks; block = next_block++) {
+      const Eigen::Index begin = block * kBlock;
+      const Eigen::Index end = std::min(n, begin + kBlock);
+      if (begin > first_error_row) return;  // a lower row already failed; the rest is moot
+      for (Eigen::Index i = begin; i < end; ++i) {
+        try {
+          const Proximity single_result =
+              proximity(a, pose_at(r_a, q_a, i, "a"), b, pose_at(r_b, q_b, i, "b"), single);
+          phi(i) = single_result.phi;
+          gradient.row(i) = single_result.gradient.transpose();
+        } catch (...) {
+          // Every block below a failing row is still processed, so the lowest row recorded is
+          // the first bad row whatever the thread timing.
+          const std::lock_guard<std::mutex> lock(error_mutex);
+          if (i < first_error_row) {
+            first_error_row = i;
+            first_error = std::current_exception();
+          }
+          break;
         }
-        return;
       }
     }
   };
   if (threads <= 1) {
-    work(0, n);
+    work();
   } else {
     std::vector<std::thread> pool;
     pool.reserve(static_cast<std::size_t>(threads));
-    for (Eigen::Index t = 0; t < threads; ++t) {
-      pool.emplace_back(work, n * t / threads, n * (t + 1) / threads);
-    }
+    for (Eigen::Index t = 0; t < threads; ++t) pool.emplace_back(work);
     for (std::thread& thread : pool) thread.join();
   }
   if (first_error) std::rethrow_exception(first_error);
+}
+
+BatchResult proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
+                            const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
+                            const Eigen::Ref<const PositionArray>& r_b,
+                            const Eigen::Ref<const QuaternionArray>& q_b,
+                            const BatchOptions& options) {
+  BatchResult result;
+  result.phi.resize(r_a.rows());
+  result.gradient.resize(r_a.rows(), 14);
+  proximity_batch(a, r_a, q_a, b, r_b, q_b, result.phi, result.gradient, options);
   return result;
 }
 

@@ -14,8 +14,8 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& u) {
 // (e.g. Q00 = 1 - 2 (y^2 + z^2), Q01 = 2 (x y - w z)); G = L(q) [0; I3] with
 // L(q) = [w -v'; v w I + [v]x].
 UnitQuaternion::UnitQuaternion(const Eigen::Vector4d& q) {
-  const double norm = q.norm();
-  unit_ = q / norm;
+  const double inverse_norm = 1.0 / q.norm();  // one square root, one division
+  unit_ = q * inverse_norm;
   const double w = unit_(0), x = unit_(1), y = unit_(2), z = unit_(3);
   // Element by element: this runs twice per query, and Eigen's comma initializer costs more.
   matrix_(0, 0) = 1.0 - 2.0 * (y * y + z * z);
@@ -27,7 +27,7 @@ UnitQuaternion::UnitQuaternion(const Eigen::Vector4d& q) {
   matrix_(2, 0) = 2.0 * (x * z - w * y);
   matrix_(2, 1) = 2.0 * (y * z + w * x);
   matrix_(2, 2) = 1.0 - 2.0 * (x * x + y * y);
-  const double g = 2.0 / norm;
+  const double g = 2.0 * inverse_norm;
   theta_to_q_(0, 0) = -g * x, theta_to_q_(0, 1) = -g * y, theta_to_q_(0, 2) = -g * z;
   theta_to_q_(1, 0) = g * w, theta_to_q_(1, 1) = -g * z, theta_to_q_(1, 2) = g * y;
   theta_to_q_(2, 0) = g * z, theta_to_q_(2, 1) = g * w, theta_to_q_(2, 2) = -g * x;

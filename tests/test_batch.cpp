@@ -86,6 +86,11 @@ TEST(Batch, RejectsMismatchedArraysAndBadThreadCounts) {
   EXPECT_THROW(
       proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b, {-1}),
       std::invalid_argument);
+  Eigen::VectorXd phi(10);
+  GradientArray gradient(9, 14);  // one row short
+  EXPECT_THROW(proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b,
+                               phi, gradient),
+               std::invalid_argument);
   const BatchResult empty = proximity_batch(capsule, PositionArray(0, 3), QuaternionArray(0, 4),
                                             capsule, PositionArray(0, 3), QuaternionArray(0, 4));
   EXPECT_EQ(empty.phi.size(), 0);

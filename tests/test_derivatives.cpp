@@ -79,8 +79,13 @@ TEST_P(Derivatives, GradientAndJacobiansMatchCentralDifferences) {
     const Pose pose_b = random_pose(rng, 1.5 * scale);
     const ProximityJacobian analytic = proximity_jacobian(a.shape, pose_a, b.shape, pose_b);
     if (analytic.cores_intersect) {
-      // Inside the intersecting set phi is flat and its gradient is exactly zero.
-      ASSERT_TRUE(analytic.gradient.isZero(1e-12 * scale)) << analytic.gradient.transpose();
+      // Inside the intersecting set phi is flat: the gradient 2 (p1 - p2)' J vanishes up to
+      // |p1 - p2| <= 1e-12 (scale + |p|), i.e. ~1e-11 scale for positions, scale^2 for q.
+      const Eigen::Matrix<double, 14, 1> gradient = analytic.gradient;
+      ASSERT_LE(gradient.segment<3>(0).norm() + gradient.segment<3>(7).norm(), 1e-10 * scale);
+      ASSERT_LE(gradient.segment<4>(3).norm() + gradient.segment<4>(10).norm(),
+                1e-10 * scale * scale)
+          << gradient.transpose();
       ++intersecting;
       continue;
     }

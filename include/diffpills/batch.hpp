@@ -26,12 +26,22 @@ struct BatchResult {
 
 // phi and the 14-entry gradient for pair i = (a at (r_a[i], q_a[i]), b at (r_b[i], q_b[i])).
 // Throws std::invalid_argument if the arrays differ in length or a pose is invalid; the message
-// names the first bad row, e.g. "q_b[17]: quaternion must be nonzero ...". The outputs are
-// allocated once; the per-pair work allocates nothing for polygons of up to 32 vertices.
+// names the first bad row, e.g. "q_b[17]: quaternion must be nonzero ...". The per-pair work
+// allocates nothing for polygons of up to 32 vertices.
 BatchResult proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
                             const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
                             const Eigen::Ref<const PositionArray>& r_b,
                             const Eigen::Ref<const QuaternionArray>& q_b,
                             const BatchOptions& options = {});
+
+// The same into caller-owned outputs (phi with N entries, gradient N x 14), for loops that call
+// the batch repeatedly: no allocation at all, and no first-touch page faults, which are
+// serialized in the kernel and cost 2-thread scaling (measured: 1.5x with fresh 12 MB outputs
+// per call for 10^5 capsule pairs). Rows past a bad row may be left unwritten.
+void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
+                     const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
+                     const Eigen::Ref<const PositionArray>& r_b,
+                     const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> phi,
+                     Eigen::Ref<GradientArray> gradient, const BatchOptions& options = {});
 
 }  // namespace diffpills

@@ -32,10 +32,10 @@
 //     linearly with a tilt, so the middle of the optimal set stays within 1e-12 of optimal).
 //   - Zero length capsules are spheres.
 //   - Intersecting cores (|p1 - p2| <= 1e-12 of the scene's size): cores_intersect is true,
-//     phi = -(R1 + R2)^2 and its gradient is zero (the proximity is flat there: keep phi > 0 with
-//     a margin in optimizers). The normal is then undefined and replaced by a deterministic
-//     choice: the unit vector from r1 to r2, or, if the origins coincide too, shape 1's body z
-//     axis Q(q1) [0, 0, 1]. Surface points and Jacobians follow that rule.
+//     phi = -(R1 + R2)^2 and its gradient vanishes up to rounding (the proximity is flat there:
+//     keep phi > 0 with a margin in optimizers). The normal is then undefined and replaced by a
+//     deterministic choice: the unit vector from r1 to r2, or, if the origins coincide too, shape
+//     1's body z axis Q(q1) [0, 0, 1]. Surface points and Jacobians follow that rule.
 //   - Non-unit quaternions are normalized; derivatives include the normalization.
 //
 // Errors: shapes and poses validate on construction (std::invalid_argument). If the QP solver

@@ -30,18 +30,21 @@ enum class NormalRule { kClosestPoints, kOrigins, kBodyAxis };
 
 // The normal's rule (see proximity.hpp): the closest-point direction while the cores are apart;
 // otherwise the direction between the body origins, or shape 1's body z axis if those coincide.
+// Compared squared, to spare square roots on the hot path.
 NormalRule normal_rule(const PosedCore& a, const PosedCore& b, const Eigen::Vector3d& p1,
                        const Eigen::Vector3d& p2) {
   const double tolerance = intersection_tolerance(a, b, p1, p2);
-  if ((p2 - p1).norm() > tolerance) return NormalRule::kClosestPoints;
-  if ((b.r - a.r).norm() > tolerance) return NormalRule::kOrigins;
+  const double tolerance2 = tolerance * tolerance;
+  if ((p2 - p1).squaredNorm() > tolerance2) return NormalRule::kClosestPoints;
+  if ((b.r - a.r).squaredNorm() > tolerance2) return NormalRule::kOrigins;
   return NormalRule::kBodyAxis;
 }
 
-// d(v / |v|) = (I - n n') / |v| dv.
-Eigen::Matrix3d unit_vector_jacobian(const Eigen::Vector3d& v) {
-  const Eigen::Vector3d n = v.normalized();
-  return (Eigen::Matrix3d::Identity() - n * n.transpose()) / v.norm();
+// d(v / |v|) = (I - n n') / |v| dv, applied as (dv - n (n' dv)) / |v| (no 3 x 3 matrix).
+Matrix3x14 unit_vector_motion(const Eigen::Vector3d& v, const Matrix3x14& dv) {
+  const double inverse_length = 1.0 / v.norm();
+  const Eigen::Vector3d n = v * inverse_length;
+  return (dv - n * (n.transpose() * dv)) * inverse_length;
 }
 
 // Implicit function theorem with the active set eliminated (core_solution.hpp). Near the
@@ -50,43 +53,43 @@ Eigen::Matrix3d unit_vector_jacobian(const Eigen::Vector3d& v) {
 // differentiating in a pose coordinate at the solution (xi = 0),
 //   M'M dxi = -(M' de/dpose|_xi + dM'/dpose e),
 //   de/dpose|_xi = dp1|_u - dp2|_u,   dM'/dq_i e = +-D_i' d(Q_i' e)/dq_i   (+ core 1, - core 2).
-// Everything is fixed-size: each side's directions fill two columns of M (unused ones are zero),
-// and the unused diagonal entries of M'M are set to the mean of the used ones, which leaves the
-// solution for the used coordinates untouched and keeps the matrix invertible.
-// Where the closest points are not unique (parallel features) M'M is singular; the pseudo-inverse
-// then gives the minimum-norm motion, with eigenvalues below 1e-12 of the largest treated as zero,
-// the relative threshold of the parallel tests (sin^2 of the angle between features). The cheap
-// explicit inverse serves whenever det(M'M) / prod(diag) > 1e-12, which rules that out.
+// M'M is Z x Z with Z = z1 + z2 <= 4 free coordinates, solved at that fixed size (a template per
+// Z) so that a capsule pair solves 2 x 2, not a padded 4 x 4. Where the closest points are not
+// unique (parallel features) M'M is singular; the pseudo-inverse then gives the minimum-norm
+// motion, eigenvalues below 1e-12 of the largest treated as zero, the relative threshold of the
+// parallel tests. The cheap closed-form inverse serves whenever det(M'M) / prod(diag) > 1e-12,
+// which rules that out.
+template <int Z>
 void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCore& b,
                       const CoreSolution& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
                       Matrix3x14& dp2) {
   const int z1 = sa.free_dimensions;
-  const int z2 = sb.free_dimensions;
-  if (z1 + z2 == 0) return;
-  Eigen::Matrix<double, 3, 4> M;
-  M.leftCols<2>() = a.attitude.matrix() * sa.free_directions;
-  M.rightCols<2>() = -b.attitude.matrix() * sb.free_directions;
-  Eigen::Matrix<double, 4, 14> rhs = -M.transpose() * (dp1 - dp2);
-  rhs.block<2, 4>(0, 3) -=
-      sa.free_directions.transpose() * a.attitude.rotate_transpose_jacobian(difference);
-  rhs.block<2, 4>(2, 10) +=
-      sb.free_directions.transpose() * b.attitude.rotate_transpose_jacobian(difference);
-  Eigen::Matrix4d hessian = M.transpose() * M;
-  const bool used[4] = {z1 > 0, z1 > 1, z2 > 0, z2 > 1};
-  double mean = 0.0;
-  for (int k = 0; k < 4; ++k) mean += used[k] ? hessian(k, k) : 0.0;
-  mean /= z1 + z2;
-  for (int k = 0; k < 4; ++k) {
-    if (!used[k]) hessian(k, k) = mean;
+  Eigen::Matrix<double, 3, Z> M;
+  Eigen::Matrix<double, Z, 14> rhs;
+  const Eigen::Matrix<double, 3, 4> turn_a = a.attitude.rotate_transpose_jacobian(difference);
+  const Eigen::Matrix<double, 3, 4> turn_b = b.attitude.rotate_transpose_jacobian(difference);
+  for (int k = 0; k < Z; ++k) {
+    const bool first = k < z1;
+    const Eigen::Vector3d direction =
+        first ? sa.free_directions.col(k) : sb.free_directions.col(k - z1);
+    M.col(k) = first ? Eigen::Vector3d(a.attitude.matrix() * direction)
+                     : Eigen::Vector3d(-b.attitude.matrix() * direction);
+    rhs.row(k) = -M.col(k).transpose() * (dp1 - dp2);
+    if (first) {
+      rhs.row(k).template segment<4>(3) -= direction.transpose() * turn_a;
+    } else {
+      rhs.row(k).template segment<4>(10) += direction.transpose() * turn_b;
+    }
   }
-  Eigen::Matrix<double, 4, 14> dxi;
+  const Eigen::Matrix<double, Z, Z> hessian = M.transpose() * M;
+  Eigen::Matrix<double, Z, 14> dxi;
   if (hessian.determinant() > 1e-12 * hessian.diagonal().prod()) {
     dxi = hessian.inverse() * rhs;
   } else {
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(hessian);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Z, Z>> eigen(hessian);
     const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
-    Eigen::Matrix4d pseudo_inverse = Eigen::Matrix4d::Zero();
-    for (int k = 0; k < 4; ++k) {
+    Eigen::Matrix<double, Z, Z> pseudo_inverse = Eigen::Matrix<double, Z, Z>::Zero();
+    for (int k = 0; k < Z; ++k) {
       const double value = eigen.eigenvalues()(k);
       if (value > 1e-12 * largest) {
         pseudo_inverse +=
@@ -95,8 +98,26 @@ void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCor
     }
     dxi = pseudo_inverse * rhs;
   }
-  dp1 += M.leftCols<2>() * dxi.topRows<2>();
-  dp2 -= M.rightCols<2>() * dxi.bottomRows<2>();  // M's right block carries the minus sign
+  for (int k = 0; k < Z; ++k) {  // dp1 += Q1 D1 dxi1, dp2 += Q2 D2 dxi2 = -(M's right block) dxi2
+    (k < z1 ? dp1 : dp2) += M.col(k) * dxi.row(k) * (k < z1 ? 1.0 : -1.0);
+  }
+}
+
+void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCore& b,
+                      const CoreSolution& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
+                      Matrix3x14& dp2) {
+  switch (sa.free_dimensions + sb.free_dimensions) {
+    case 1:
+      return add_point_motion<1>(a, sa, b, sb, difference, dp1, dp2);
+    case 2:
+      return add_point_motion<2>(a, sa, b, sb, difference, dp1, dp2);
+    case 3:
+      return add_point_motion<3>(a, sa, b, sb, difference, dp1, dp2);
+    case 4:
+      return add_point_motion<4>(a, sa, b, sb, difference, dp1, dp2);
+    default:
+      return;  // both points fixed (vertices, segment ends, spheres): nothing moves them
+  }
 }
 
 }  // namespace
@@ -120,7 +141,7 @@ Proximity make_proximity(const PosedCore& a, const CoreSolution& solution_a, con
 
   switch (normal_rule(a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
-      result.normal = (p2 - p1).normalized();
+      result.normal = difference * (-1.0 / difference.norm());  // one division, not three
       break;
     case NormalRule::kOrigins:
       result.cores_intersect = true;
@@ -151,12 +172,13 @@ ProximityJacobian make_proximity_jacobian(const PosedCore& a, const CoreSolution
   Matrix3x14 dnormal = Matrix3x14::Zero();
   switch (normal_rule(a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
-      dnormal = unit_vector_jacobian(p2 - p1) * (dp2 - dp1);
+      dnormal = unit_vector_motion(p2 - p1, dp2 - dp1);
       break;
     case NormalRule::kOrigins: {
-      const Eigen::Matrix3d d_unit = unit_vector_jacobian(b.r - a.r);
-      dnormal.block<3, 3>(0, 0) = -d_unit;
-      dnormal.block<3, 3>(0, 7) = d_unit;
+      Matrix3x14 d_origins = Matrix3x14::Zero();  // d(r2 - r1)
+      d_origins.block<3, 3>(0, 0) = -Eigen::Matrix3d::Identity();
+      d_origins.block<3, 3>(0, 7) = Eigen::Matrix3d::Identity();
+      dnormal = unit_vector_motion(b.r - a.r, d_origins);
       break;
     }
     case NormalRule::kBodyAxis:
