@@ -9,23 +9,10 @@
 #include "diffpills/diffpills.hpp"
 #include "support/random_shapes.hpp"
 #include "support/reference.hpp"
+#include "support/scene_helpers.hpp"
 
 namespace diffpills::testing {
 namespace {
-
-const Eigen::Vector4d kIdentity(1, 0, 0, 0);
-
-// Rotation by `angle` about the unit axis (x, y, z).
-Eigen::Vector4d about(double angle, double x, double y, double z) {
-  return {std::cos(angle / 2), std::sin(angle / 2) * x, std::sin(angle / 2) * y,
-          std::sin(angle / 2) * z};
-}
-
-PaddedPolygon square(double half, double radius) {
-  Eigen::MatrixX2d C(4, 2);
-  C << 1, 0, 0, 1, -1, 0, 0, -1;
-  return PaddedPolygon(C, Eigen::VectorXd::Constant(4, half), radius);
-}
 
 template <class A, class B>
 ProximityJacobian query(const A& a, const Pose& pa, const B& b, const Pose& pb) {

@@ -10,6 +10,7 @@
 
 #include "diffpills/diffpills.hpp"
 #include "support/random_shapes.hpp"
+#include "support/scene_helpers.hpp"
 
 namespace diffpills::testing {
 namespace {
@@ -76,19 +77,6 @@ TEST(FastVsReference, AgreeOnRandomPairs) {
               << ", points " << tally.points << ", gradient " << tally.gradient << ", Jacobian "
               << tally.jacobian << "\n";
   }
-}
-
-const Eigen::Vector4d kIdentity(1, 0, 0, 0);
-
-Eigen::Vector4d about(double angle, double x, double y, double z) {
-  return {std::cos(angle / 2), std::sin(angle / 2) * x, std::sin(angle / 2) * y,
-          std::sin(angle / 2) * z};
-}
-
-Shape square(double half, double radius) {
-  Eigen::MatrixX2d C(4, 2);
-  C << 1, 0, 0, 1, -1, 0, 0, -1;
-  return PaddedPolygon(C, Eigen::VectorXd::Constant(4, half), radius);
 }
 
 TEST(FastVsReference, AgreeOnDegenerateConfigurations) {

@@ -63,6 +63,10 @@ TEST(Rotation, JacobiansMatchCentralDifferences) {
               1e-8);
     // Normalization is built in: no sensitivity along q itself.
     EXPECT_LE((rotate_jacobian(q, v) * q).norm(), 1e-12 * v.norm());
+    // The gradient of w . Q v is w' times the Jacobian, formed without it.
+    const Eigen::Vector3d w = random_vector(rng);
+    EXPECT_LE((rotate_gradient(q, v, w) - rotate_jacobian(q, v).transpose() * w).norm(),
+              1e-12 * (1 + v.norm() * w.norm()) / q.norm());
   }
 }
 

@@ -15,18 +15,12 @@ Eigen::Vector3d PairProblem::body_point(int i, const Eigen::VectorXd& x) const {
   return core.U.leftCols(core.dim) * parameters(i, x) + core.u0;
 }
 
-Eigen::Vector3d PairProblem::world_point(int i, const Eigen::VectorXd& x) const {
-  const auto k = static_cast<std::size_t>(i);
-  return r[k] + rotation[k] * body_point(i, x);
-}
-
 PairProblem make_pair_problem(const Core& core1, const Pose& pose1, const Core& core2,
                               const Pose& pose2) {
   PairProblem problem;
   problem.cores = {&core1, &core2};
-  problem.r = {pose1.r(), pose2.r()};
-  problem.q = {pose1.q(), pose2.q()};
-  problem.rotation = {rotation_matrix(pose1.q()), rotation_matrix(pose2.q())};
+  const Eigen::Matrix3d rotation1 = rotation_matrix(pose1.q());
+  const Eigen::Matrix3d rotation2 = rotation_matrix(pose2.q());
   // Two spheres have no parameters and no size; any positive scale then serves.
   problem.scale = std::max(core1.size, core2.size);
   if (problem.scale == 0.0) {
@@ -36,10 +30,9 @@ PairProblem make_pair_problem(const Core& core1, const Pose& pose1, const Core& 
   const int n2 = core2.dim;
   const double inverse_scale = 1.0 / problem.scale;
   problem.F.resize(3, n1 + n2);
-  problem.F.leftCols(n1) = inverse_scale * problem.rotation[0] * core1.U.leftCols(n1);
-  problem.F.rightCols(n2) = -inverse_scale * problem.rotation[1] * core2.U.leftCols(n2);
-  problem.g = inverse_scale * (pose1.r() + problem.rotation[0] * core1.u0 - pose2.r() -
-                               problem.rotation[1] * core2.u0);
+  problem.F.leftCols(n1) = inverse_scale * rotation1 * core1.U.leftCols(n1);
+  problem.F.rightCols(n2) = -inverse_scale * rotation2 * core2.U.leftCols(n2);
+  problem.g = inverse_scale * (pose1.r() + rotation1 * core1.u0 - pose2.r() - rotation2 * core2.u0);
   const Eigen::Index m1 = core1.G.rows();
   const Eigen::Index m2 = core2.G.rows();
   problem.G = Eigen::MatrixXd::Zero(m1 + m2, n1 + n2);

@@ -22,9 +22,6 @@ namespace diffpills::detail {
 
 struct PairProblem {
   std::array<const Core*, 2> cores{};
-  std::array<Eigen::Vector3d, 2> r;
-  std::array<Eigen::Vector4d, 2> q;
-  std::array<Eigen::Matrix3d, 2> rotation;
   double scale = 1.0;  // s
   Eigen::MatrixXd F;   // 3 x n
   Eigen::Vector3d g;
@@ -34,9 +31,8 @@ struct PairProblem {
   int n() const { return cores[0]->dim + cores[1]->dim; }
   // The parameters of core i within x.
   Eigen::VectorXd parameters(int i, const Eigen::VectorXd& x) const;
-  // Body-frame point U_i x_i + u0_i and world point r_i + Q_i (U_i x_i + u0_i) of core i.
+  // Body-frame point U_i x_i + u0_i of core i.
   Eigen::Vector3d body_point(int i, const Eigen::VectorXd& x) const;
-  Eigen::Vector3d world_point(int i, const Eigen::VectorXd& x) const;
 };
 
 // The cores must outlive the problem.
