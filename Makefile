@@ -27,8 +27,9 @@ test-sanitize: deps
 	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(SANITIZE_BUILD) --output-on-failure -LE no_sanitize
 
+# The motion-planning demo: solves the car-bus problem, writes out/*.csv, *.json, *.svg.
 demo: build
-	./$(BUILD)/apps/diffpills demo
+	./$(BUILD)/examples/diffpills_demo out
 
 bench: build
 	./$(BUILD)/bench/bench_proximity --benchmark_min_time=0.2

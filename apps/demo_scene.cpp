@@ -19,8 +19,7 @@ void print_vector(std::ostream& out, const char* label, const Eigen::VectorXd& v
 
 }  // namespace
 
-int run_scene_demo(std::ostream& out) {
-  // A padded regular hexagon lying tilted near the origin and a capsule hovering beside it.
+Fig1Scene fig1_scene() {
   Eigen::MatrixX2d C(6, 2);
   Eigen::VectorXd d(6);
   for (int i = 0; i < 6; ++i) {
@@ -28,11 +27,17 @@ int run_scene_demo(std::ostream& out) {
     C.row(i) << std::cos(angle), std::sin(angle);
     d(i) = 0.6;
   }
-  const PaddedPolygon polygon(C, d, 0.1);
-  const Pose polygon_pose({0.0, 0.0, 0.0}, {std::cos(0.2), std::sin(0.2), 0.0, 0.0});
-  const Capsule capsule(1.2, 0.2);
-  const Pose capsule_pose({0.4, 0.3, 0.9}, {std::cos(0.35), 0.0, std::sin(0.35), 0.0});
+  return {Capsule(1.2, 0.2), Pose({0.4, 0.3, 0.9}, {std::cos(0.35), 0.0, std::sin(0.35), 0.0}),
+          PaddedPolygon(C, d, 0.1),
+          Pose({0.0, 0.0, 0.0}, {std::cos(0.2), std::sin(0.2), 0.0, 0.0})};
+}
 
+int run_scene_demo(std::ostream& out) {
+  const Fig1Scene scene = fig1_scene();
+  const Capsule& capsule = scene.capsule;
+  const Pose& capsule_pose = scene.capsule_pose;
+  const PaddedPolygon& polygon = scene.polygon;
+  const Pose& polygon_pose = scene.polygon_pose;
   const ProximityJacobian result = proximity_jacobian(capsule, capsule_pose, polygon, polygon_pose);
   out << "diffpills " << kVersion << " -- the paper's Fig. 1 scene\n"
       << "  shape 1: capsule, length 1.2, radius 0.2, r = [0.4, 0.3, 0.9]\n"

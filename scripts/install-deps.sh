@@ -11,6 +11,9 @@ packages=(
   libbenchmark-dev       # benchmarks
   libfcl-dev             # independent distances for tests and benchmarks
   nlohmann-json3-dev     # JSON for `diffpills query`
+  coinor-libipopt-dev    # NLP cross-check of the trajectory optimizer
+  pkg-config             # finds Ipopt
+  librsvg2-bin           # rsvg-convert: lets a person look at the demo's SVG figures as PNG
 )
 
 missing=()

@@ -1,0 +1,126 @@
+#include "car_bus.hpp"
+
+#include <cmath>
+
+namespace diffpills::examples {
+
+Pose car_pose(const Eigen::VectorXd& x) {
+  return Pose(Eigen::Vector3d(x(0), x(1), 0.0),
+              Eigen::Vector4d(std::cos(0.5 * x(2)), 0.0, 0.0, std::sin(0.5 * x(2))));
+}
+
+// dphi/dx = [dphi/dr_x, dphi/dr_y, dphi/dq . dq/dtheta, 0, 0] with
+// dq/dtheta = [-sin(theta/2), 0, 0, cos(theta/2)] / 2.
+double car_bus_phi(const CarBusScenario& scenario, const Eigen::VectorXd& x,
+                   Eigen::VectorXd* gradient) {
+  const Proximity p = proximity(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
+  if (gradient != nullptr) {
+    const Eigen::Vector4d dq_dtheta(-0.5 * std::sin(0.5 * x(2)), 0.0, 0.0,
+                                    0.5 * std::cos(0.5 * x(2)));
+    gradient->setZero(5);
+    (*gradient)(0) = p.gradient(0);
+    (*gradient)(1) = p.gradient(1);
+    (*gradient)(2) = p.gradient.segment<4>(3).dot(dq_dtheta);
+  }
+  return p.phi;
+}
+
+CarBusProblem::CarBusProblem(CarBusScenario scenario) : scenario_(std::move(scenario)) {
+  Q_ = 0.01 * Eigen::MatrixXd::Identity(5, 5);
+  R_ = 0.1 * Eigen::MatrixXd::Identity(2, 2);
+  Qf_ = Eigen::VectorXd((Eigen::VectorXd(5) << 0.0, 0.0, 0.0, 10.0, 10.0).finished()).asDiagonal();
+}
+
+void CarBusProblem::dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                             Eigen::VectorXd& next, Eigen::MatrixXd& A, Eigen::MatrixXd& B) const {
+  trajopt::Car::State fixed_next;
+  Eigen::Matrix<double, 5, 5> fixed_A;
+  Eigen::Matrix<double, 5, 2> fixed_B;
+  scenario_.car_model.step(scenario_.dt, x, u, fixed_next, fixed_A, fixed_B);
+  next = fixed_next;
+  A = fixed_A;
+  B = fixed_B;
+}
+
+trajopt::CostExpansion CarBusProblem::stage_cost(int, const Eigen::VectorXd& x,
+                                                 const Eigen::VectorXd& u) const {
+  const Eigen::VectorXd e = x - scenario_.goal;
+  return {0.5 * e.dot(Q_ * e) + 0.5 * u.dot(R_ * u),
+          Q_ * e,
+          R_ * u,
+          Q_,
+          R_,
+          Eigen::MatrixXd::Zero(2, 5)};
+}
+
+trajopt::CostExpansion CarBusProblem::terminal_cost(const Eigen::VectorXd& x) const {
+  const Eigen::VectorXd e = x - scenario_.goal;
+  return {0.5 * e.dot(Qf_ * e), Qf_ * e,          Eigen::VectorXd(), Qf_,
+          Eigen::MatrixXd(),    Eigen::MatrixXd()};
+}
+
+double CarBusProblem::stage_cost_value(int, const Eigen::VectorXd& x,
+                                       const Eigen::VectorXd& u) const {
+  const Eigen::VectorXd e = x - scenario_.goal;
+  return 0.5 * e.dot(Q_ * e) + 0.5 * u.dot(R_ * u);
+}
+
+double CarBusProblem::terminal_cost_value(const Eigen::VectorXd& x) const {
+  const Eigen::VectorXd e = x - scenario_.goal;
+  return 0.5 * e.dot(Qf_ * e);
+}
+
+trajopt::KnotConstraints CarBusProblem::constraints(int k, const Eigen::VectorXd& x,
+                                                    const Eigen::VectorXd& u) const {
+  return evaluate_constraints(k, x, u, true);
+}
+
+trajopt::KnotConstraints CarBusProblem::constraint_values(int k, const Eigen::VectorXd& x,
+                                                          const Eigen::VectorXd& u) const {
+  return evaluate_constraints(k, x, u, false);
+}
+
+// Rows: [equalities: px, py, theta - goal (last knot only)], -phi, then u - limit, -u - limit.
+trajopt::KnotConstraints CarBusProblem::evaluate_constraints(int k, const Eigen::VectorXd& x,
+                                                             const Eigen::VectorXd& u,
+                                                             bool derivatives) const {
+  const bool last = k == scenario_.knots - 1;
+  const int equalities = last ? 3 : 0;
+  const int rows = equalities + 1 + (last ? 0 : 4);
+  trajopt::KnotConstraints c;
+  c.equalities = equalities;
+  c.value = Eigen::VectorXd::Zero(rows);
+  if (derivatives) {
+    c.dx = Eigen::MatrixXd::Zero(rows, 5);
+    c.du = Eigen::MatrixXd::Zero(rows, last ? 0 : 2);
+  }
+  if (last) {
+    c.value.head<3>() = x.head<3>() - scenario_.goal.head<3>();
+    if (derivatives) c.dx.topLeftCorner<3, 3>().setIdentity();
+  }
+  Eigen::VectorXd gradient;
+  c.value(equalities) = -car_bus_phi(scenario_, x, derivatives ? &gradient : nullptr);
+  if (derivatives) c.dx.row(equalities) = -gradient.transpose();
+  if (!last) {
+    for (int i = 0; i < 2; ++i) {
+      c.value(equalities + 1 + i) = u(i) - scenario_.control_limit(i);
+      c.value(equalities + 3 + i) = -u(i) - scenario_.control_limit(i);
+      if (derivatives) {
+        c.du(equalities + 1 + i, i) = 1.0;
+        c.du(equalities + 3 + i, i) = -1.0;
+      }
+    }
+  }
+  return c;
+}
+
+std::vector<Eigen::VectorXd> CarBusProblem::straight_line_controls() const {
+  const int steps = scenario_.knots - 1;
+  const double half = 0.5 * steps * scenario_.dt;
+  const double acceleration = (scenario_.goal(0) - scenario_.x0(0)) / (half * half);
+  std::vector<Eigen::VectorXd> controls(steps, Eigen::Vector2d::Zero());
+  for (int k = 0; k < steps; ++k) controls[k](0) = k < steps / 2 ? acceleration : -acceleration;
+  return controls;
+}
+
+}  // namespace diffpills::examples

@@ -1,0 +1,67 @@
+// The paper's section V scene: a car (capsule) drives from the left to a goal at the lower right
+// past a parked bus (capsule) in between, with phi(car, bus) >= 0 at every knot.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "diffpills/diffpills.hpp"
+#include "diffpills/trajopt/altro.hpp"
+#include "diffpills/trajopt/car.hpp"
+
+namespace diffpills::examples {
+
+struct CarBusScenario {
+  double dt = 0.1;
+  int knots = 51;
+  trajopt::Car car_model{2.5};
+  Capsule car{2.0, 0.9};  // core length along the car's heading, radius
+  Capsule bus{8.0, 1.3};
+  Pose bus_pose{Eigen::Vector3d(10.0, -2.0, 0.0), Eigen::Vector4d(1.0, 0.0, 0.0, 0.0)};
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(5);
+  Eigen::VectorXd goal = (Eigen::VectorXd(5) << 20.0, -4.0, 0.0, 0.0, 0.0).finished();
+  Eigen::Vector2d control_limit{4.0, 1.0};  // |acceleration|, |steering rate|
+};
+
+// The car's pose at state x: r = (px, py, 0), q = rotation by theta about z.
+Pose car_pose(const Eigen::VectorXd& x);
+
+// phi(car at x, bus) and its gradient with respect to the state (through the pose).
+double car_bus_phi(const CarBusScenario& scenario, const Eigen::VectorXd& x,
+                   Eigen::VectorXd* gradient = nullptr);
+
+// Costs 1/2 (x - goal)'Q(x - goal) + 1/2 u'Ru per knot and 1/2 (x - goal)'Qf(x - goal) at the
+// end; constraints -phi <= 0 at every knot, |u| <= control_limit at every control, and the final
+// position and heading equal to the goal's.
+class CarBusProblem : public trajopt::Problem {
+ public:
+  explicit CarBusProblem(CarBusScenario scenario);
+
+  int state_size() const override { return 5; }
+  int control_size() const override { return 2; }
+  int knots() const override { return scenario_.knots; }
+  void dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& next,
+                Eigen::MatrixXd& A, Eigen::MatrixXd& B) const override;
+  trajopt::CostExpansion stage_cost(int k, const Eigen::VectorXd& x,
+                                    const Eigen::VectorXd& u) const override;
+  trajopt::CostExpansion terminal_cost(const Eigen::VectorXd& x) const override;
+  trajopt::KnotConstraints constraints(int k, const Eigen::VectorXd& x,
+                                       const Eigen::VectorXd& u) const override;
+  double stage_cost_value(int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u) const override;
+  double terminal_cost_value(const Eigen::VectorXd& x) const override;
+  trajopt::KnotConstraints constraint_values(int k, const Eigen::VectorXd& x,
+                                             const Eigen::VectorXd& u) const override;
+
+  const CarBusScenario& scenario() const { return scenario_; }
+  // Straight ahead along the initial heading: accelerate for half the horizon, brake for the
+  // other half, covering the distance to the goal's x. It drives through the bus.
+  std::vector<Eigen::VectorXd> straight_line_controls() const;
+
+ private:
+  trajopt::KnotConstraints evaluate_constraints(int k, const Eigen::VectorXd& x,
+                                                const Eigen::VectorXd& u, bool derivatives) const;
+
+  CarBusScenario scenario_;
+  Eigen::MatrixXd Q_, R_, Qf_;
+};
+
+}  // namespace diffpills::examples

@@ -1,0 +1,33 @@
+// The car-bus problem as a nonlinear program for Ipopt, to cross-check the ALTRO solver: the same
+// discretization, costs and constraints (CarBusProblem), written as
+//   variables   z = [x_0 .. x_{N-1}, u_0 .. u_{N-2}]
+//   minimize    the same costs
+//   subject to  x_{k+1} - f(x_k, u_k) = 0,  phi(x_k) >= 0,
+//               x_0 = x0 and the final position and heading = goal (variable bounds),
+//               |u| <= control_limit (variable bounds)
+// with exact first derivatives and Ipopt's limited-memory Hessian approximation.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "car_bus.hpp"
+
+namespace diffpills::examples {
+
+struct IpoptRun {
+  bool solved = false;
+  std::string status;
+  int iterations = 0;
+  double cost = 0.0;
+  double max_violation = 0.0;  // dynamics defects, phi < 0, bounds
+  double solve_ms = 0.0;
+  std::vector<Eigen::VectorXd> states, controls;
+};
+
+// Starts from the rollout of initial_controls, as ALTRO does.
+IpoptRun solve_with_ipopt(const CarBusProblem& problem,
+                          const std::vector<Eigen::VectorXd>& initial_controls);
+
+}  // namespace diffpills::examples

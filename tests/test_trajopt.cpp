@@ -1,0 +1,189 @@
+// The trajectory optimizer: iLQR against the Riccati solution of an LQ problem, RK4 Jacobians
+// against central differences, and a constrained car problem whose solution is checked knot by
+// knot by independent computations.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <iostream>
+#include <random>
+
+#include "car_bus/car_bus.hpp"
+#include "car_bus/car_bus_ipopt.hpp"
+#include "diffpills/trajopt/altro.hpp"
+#include "diffpills/trajopt/car.hpp"
+#include "diffpills/trajopt/rk4.hpp"
+
+namespace diffpills::trajopt {
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+// x+ = A x + B u, cost sum 1/2 x'Qx + 1/2 u'Ru + 1/2 x_N' Qf x_N, optionally with constraints.
+class LinearQuadratic : public Problem {
+ public:
+  LinearQuadratic(MatrixXd A, MatrixXd B, MatrixXd Q, MatrixXd R, MatrixXd Qf, int knots)
+      : A_(std::move(A)),
+        B_(std::move(B)),
+        Q_(std::move(Q)),
+        R_(std::move(R)),
+        Qf_(std::move(Qf)),
+        knots_(knots) {}
+  int state_size() const override { return static_cast<int>(A_.rows()); }
+  int control_size() const override { return static_cast<int>(B_.cols()); }
+  int knots() const override { return knots_; }
+  void dynamics(const VectorXd& x, const VectorXd& u, VectorXd& next, MatrixXd& A,
+                MatrixXd& B) const override {
+    next = A_ * x + B_ * u;
+    A = A_;
+    B = B_;
+  }
+  CostExpansion stage_cost(int, const VectorXd& x, const VectorXd& u) const override {
+    return {0.5 * x.dot(Q_ * x) + 0.5 * u.dot(R_ * u), Q_ * x, R_ * u, Q_, R_,
+            MatrixXd::Zero(u.size(), x.size())};
+  }
+  CostExpansion terminal_cost(const VectorXd& x) const override {
+    return {0.5 * x.dot(Qf_ * x), Qf_ * x, VectorXd(), Qf_, MatrixXd(), MatrixXd()};
+  }
+
+ private:
+  MatrixXd A_, B_, Q_, R_, Qf_;
+  int knots_;
+};
+
+MatrixXd random_matrix(std::mt19937_64& rng, int rows, int cols) {
+  std::normal_distribution<double> normal;
+  MatrixXd m(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) m(i, j) = normal(rng);
+  return m;
+}
+
+TEST(Trajopt, UnconstrainedLinearQuadraticMatchesRiccati) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int n = 4, m = 2, N = 30;
+    const MatrixXd A = MatrixXd::Identity(n, n) + 0.1 * random_matrix(rng, n, n);
+    const MatrixXd B = 0.1 * random_matrix(rng, n, m);
+    const MatrixXd L = random_matrix(rng, n, n);
+    const MatrixXd Q = L.transpose() * L + MatrixXd::Identity(n, n);
+    const MatrixXd R = MatrixXd::Identity(m, m) * 0.5;
+    const MatrixXd Qf = 10.0 * Q;
+    const VectorXd x0 = random_matrix(rng, n, 1);
+    // Riccati: P_N = Qf, K = -(R + B'PB)^-1 B'PA, P = Q + A'PA + A'PB K.
+    std::vector<MatrixXd> gains(N - 1);
+    MatrixXd P = Qf;
+    for (int k = N - 2; k >= 0; --k) {
+      gains[k] = -(R + B.transpose() * P * B).ldlt().solve(B.transpose() * P * A);
+      P = Q + A.transpose() * P * A + A.transpose() * P * B * gains[k];
+      P = 0.5 * (P + P.transpose());
+    }
+    VectorXd x = x0;
+    std::vector<VectorXd> riccati(N - 1);
+    for (int k = 0; k + 1 < N; ++k) {
+      riccati[k] = gains[k] * x;
+      x = A * x + B * riccati[k];
+    }
+    const LinearQuadratic problem(A, B, Q, R, Qf, N);
+    const AltroResult result = solve(problem, x0, std::vector<VectorXd>(N - 1, VectorXd::Zero(m)));
+    ASSERT_EQ(result.status, AltroStatus::kSolved) << to_string(result.status);
+    for (int k = 0; k + 1 < N; ++k) {
+      ASSERT_LE((result.controls[k] - riccati[k]).norm(), 1e-6 * (1 + riccati[k].norm()))
+          << "trial " << trial << " knot " << k;
+    }
+    EXPECT_LE(result.iterations, 5);  // LQ: one Newton step, then the convergence check
+  }
+}
+
+TEST(Trajopt, Rk4JacobiansMatchCentralDifferences) {
+  const Car car{2.5};
+  std::mt19937_64 rng(8);
+  const auto step = [&](const Car::State& x, const Car::Control& u) {
+    Car::State next;
+    Eigen::Matrix<double, 5, 5> A;
+    Eigen::Matrix<double, 5, 2> B;
+    car.step(0.1, x, u, next, A, B);
+    return next;
+  };
+  for (int trial = 0; trial < 200; ++trial) {
+    const Car::State x = random_matrix(rng, 5, 1) * 0.5;
+    const Car::Control u = random_matrix(rng, 2, 1);
+    Car::State next;
+    Eigen::Matrix<double, 5, 5> A;
+    Eigen::Matrix<double, 5, 2> B;
+    car.step(0.1, x, u, next, A, B);
+    for (int j = 0; j < 5; ++j) {
+      Car::State plus = x, minus = x;
+      plus(j) += 1e-6;
+      minus(j) -= 1e-6;
+      EXPECT_LE(((step(plus, u) - step(minus, u)) / 2e-6 - A.col(j)).norm(), 1e-8);
+    }
+    for (int j = 0; j < 2; ++j) {
+      Car::Control plus = u, minus = u;
+      plus(j) += 1e-6;
+      minus(j) -= 1e-6;
+      EXPECT_LE(((step(x, plus) - step(x, minus)) / 2e-6 - B.col(j)).norm(), 1e-8);
+    }
+  }
+}
+
+// The car-bus scene: the straight-line guess drives through the bus; the solution must satisfy
+// every constraint, checked here independently of the solver: phi recomputed from the library at
+// each state, the control limits, the goal, and the states re-integrated by a separate RK4.
+TEST(Trajopt, CarPassesTheBusAndReachesTheGoal) {
+  const examples::CarBusProblem problem{examples::CarBusScenario{}};
+  const examples::CarBusScenario& s = problem.scenario();
+  const std::vector<VectorXd> guess = problem.straight_line_controls();
+  VectorXd x = s.x0;
+  double guess_min_phi = examples::car_bus_phi(s, x);
+  for (const VectorXd& u : guess) {
+    VectorXd next;
+    MatrixXd A, B;
+    problem.dynamics(x, u, next, A, B);
+    x = next;
+    guess_min_phi = std::min(guess_min_phi, examples::car_bus_phi(s, x));
+  }
+  EXPECT_LT(guess_min_phi, 0.0);  // the straight line collides
+
+  const AltroResult result = solve(problem, s.x0, guess);
+  ASSERT_EQ(result.status, AltroStatus::kSolved) << to_string(result.status);
+  EXPECT_LE(result.max_violation, 1e-6);
+  const auto car_rate = [&](const VectorXd& state, const VectorXd& u) {  // written out again
+    VectorXd rate(5);
+    rate << state(3) * std::cos(state(2)), state(3) * std::sin(state(2)),
+        state(3) * std::tan(state(4)) / s.car_model.wheelbase, u(0), u(1);
+    return rate;
+  };
+  for (int k = 0; k < s.knots; ++k) {
+    const VectorXd& xk = result.states[k];
+    const Proximity p = proximity(s.car, examples::car_pose(xk), s.bus, s.bus_pose);
+    EXPECT_GE(p.phi, -1e-6) << "knot " << k;
+    if (k + 1 < s.knots) {
+      const VectorXd& u = result.controls[k];
+      EXPECT_LE(u.cwiseAbs()(0), s.control_limit(0) + 1e-6);
+      EXPECT_LE(u.cwiseAbs()(1), s.control_limit(1) + 1e-6);
+      const VectorXd k1 = car_rate(xk, u), k2 = car_rate(xk + 0.5 * s.dt * k1, u),
+                     k3 = car_rate(xk + 0.5 * s.dt * k2, u), k4 = car_rate(xk + s.dt * k3, u);
+      const VectorXd next = xk + s.dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
+      EXPECT_LE((next - result.states[k + 1]).norm(), 1e-12) << "knot " << k;
+    }
+  }
+  EXPECT_LE((result.states.back().head<3>() - s.goal.head<3>()).cwiseAbs().maxCoeff(), 1e-6);
+  // Ipopt on the same NLP from the same guess: feasible, and the same cost within 1%.
+  const examples::IpoptRun ipopt = examples::solve_with_ipopt(problem, guess);
+  ASSERT_TRUE(ipopt.solved) << ipopt.status;
+  EXPECT_LE(ipopt.max_violation, 1e-6);
+  for (const VectorXd& xk : ipopt.states) {
+    EXPECT_GE(proximity(s.car, examples::car_pose(xk), s.bus, s.bus_pose).phi, -1e-6);
+  }
+  EXPECT_LE(std::abs(ipopt.cost - result.cost), 0.01 * std::abs(ipopt.cost));
+  std::cout << "[car-bus] Ipopt: " << ipopt.iterations << " iterations, cost " << ipopt.cost
+            << ", ALTRO cost " << result.cost << "\n";
+  std::cout << "[car-bus] iterations " << result.iterations << " (outer " << result.outer_iterations
+            << "), cost " << result.cost << ", max violation " << result.max_violation
+            << ", straight-line guess min phi " << guess_min_phi << "\n";
+}
+
+}  // namespace
+}  // namespace diffpills::trajopt

@@ -1,0 +1,64 @@
+// An ALTRO-style solver (Howell, Jackson, Manchester 2019): an augmented Lagrangian outer loop
+// around iLQR, with Altro.jl's defaults.
+//
+// Outer loop: the constraints enter the cost as lambda'c + 1/2 c' I_mu c, with I_mu = mu on
+// equalities and on inequalities that are violated or have lambda > 0, zero otherwise. After each
+// inner solve lambda <- max(0, lambda + mu c) (inequalities; equalities without the max), and
+// mu <- min(10 mu, 1e8), until the largest violation is below constraint_tolerance.
+// Inner loop: iLQR on that cost. The backward pass regularizes Quu + rho I, with rho grown by 1.6
+// on a failed factorization or line search and kept in [1e-8, 1e8]; the forward pass backtracks
+// from a full step and accepts when actual / expected decrease lies in [1e-8, 10].
+// Every loop has a cap; the result says how it ended.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "diffpills/trajopt/problem.hpp"
+
+namespace diffpills::trajopt {
+
+struct AltroSettings {
+  int max_outer_iterations = 30;
+  int max_inner_iterations = 200;  // per outer iteration
+  int max_total_iterations = 1000;
+  double constraint_tolerance = 1e-6;
+  double cost_tolerance = 1e-8;      // inner convergence: relative decrease of the AL cost
+  double gradient_tolerance = 1e-6;  // inner convergence: largest feedforward step, relative
+  double penalty_initial = 1.0;
+  double penalty_scaling = 10.0;
+  double penalty_max = 1e8;
+  double regularization_initial = 1e-8;
+  double regularization_min = 1e-8;
+  double regularization_max = 1e8;
+  double regularization_growth = 1.6;
+  double line_search_lower = 1e-8;
+  double line_search_upper = 10.0;
+  int line_search_steps = 20;
+};
+
+enum class AltroStatus {
+  kSolved,                 // max violation <= constraint_tolerance and the inner loop converged
+  kMaxIterations,          // an iteration cap was reached first
+  kRegularizationFailure,  // rho exceeded regularization_max
+};
+
+const char* to_string(AltroStatus status);
+
+struct AltroResult {
+  std::vector<Eigen::VectorXd> states;    // N
+  std::vector<Eigen::VectorXd> controls;  // N - 1
+  AltroStatus status = AltroStatus::kMaxIterations;
+  double cost = 0.0;           // the problem's cost, without constraint terms
+  double max_violation = 0.0;  // largest equality |e| or positive inequality c
+  int iterations = 0;          // iLQR iterations, over all outer iterations
+  int outer_iterations = 0;
+};
+
+// Solves from x0 with the controls as the initial guess (N - 1 of them; the states follow by
+// rollout). Throws std::invalid_argument on sizes that do not match the problem.
+AltroResult solve(const Problem& problem, const Eigen::VectorXd& x0,
+                  const std::vector<Eigen::VectorXd>& initial_controls,
+                  const AltroSettings& settings = {});
+
+}  // namespace diffpills::trajopt
