@@ -128,6 +128,35 @@ TEST(Trajopt, Rk4JacobiansMatchCentralDifferences) {
   }
 }
 
+// The collision constraint's gradient with respect to the car's state (phi's pose gradient
+// chained through r = (px, py, 0), q = rotation by theta about z) against central differences.
+TEST(Trajopt, CarBusPhiGradientMatchesCentralDifferences) {
+  const examples::CarBusScenario s;
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> box(-1.0, 1.0);
+  int checked = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    VectorXd x(5);
+    x << 10.0 + 8.0 * box(rng), -2.0 + 4.0 * box(rng), M_PI * box(rng), box(rng), box(rng);
+    VectorXd gradient;
+    examples::car_bus_phi(s, x, &gradient);
+    VectorXd fd(5);
+    for (int j = 0; j < 5; ++j) {
+      VectorXd plus = x, minus = x;
+      plus(j) += 1e-6;
+      minus(j) -= 1e-6;
+      fd(j) = (examples::car_bus_phi(s, plus) - examples::car_bus_phi(s, minus)) / 2e-6;
+    }
+    if (examples::car_bus_phi(s, x) <
+        -(s.car.radius() + s.bus.radius()) * (s.car.radius() + s.bus.radius()) + 1e-9) {
+      continue;  // cores intersect: phi is flat there
+    }
+    EXPECT_LE((gradient - fd).norm(), 1e-6 * (1.0 + fd.norm())) << "trial " << trial;
+    ++checked;
+  }
+  EXPECT_GT(checked, 300);
+}
+
 // The car-bus scene: the straight-line guess drives through the bus; the solution must satisfy
 // every constraint, checked here independently of the solver: phi recomputed from the library at
 // each state, the control limits, the goal, and the states re-integrated by a separate RK4.

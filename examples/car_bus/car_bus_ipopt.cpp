@@ -20,8 +20,10 @@ constexpr double kInfinity = 1e19;  // Ipopt's default nlp_upper_bound_inf
 // Index bookkeeping for z = [x_0 .. x_{N-1}, u_0 .. u_{N-2}].
 struct Layout {
   int knots;
-  int state(int k) const { return kState * k; }
-  int control(int k) const { return kState * knots + kControl * k; }
+  std::ptrdiff_t state(int k) const { return std::ptrdiff_t{kState} * k; }
+  std::ptrdiff_t control(int k) const {
+    return std::ptrdiff_t{kState} * knots + std::ptrdiff_t{kControl} * k;
+  }
   int variables() const { return kState * knots + kControl * (knots - 1); }
   int defects() const { return kState * (knots - 1); }
   int constraints() const { return defects() + knots; }  // dynamics, then phi per knot
@@ -98,7 +100,7 @@ class CarBusNlp : public Ipopt::TNLP {
       Eigen::VectorXd next;
       Eigen::MatrixXd A, B;
       problem_.dynamics(state(z, k), control(z, k), next, A, B);
-      Eigen::Map<Eigen::VectorXd>(g + kState * k, kState) = state(z, k + 1) - next;
+      Eigen::Map<Eigen::VectorXd>(g + layout_.state(k), kState) = state(z, k + 1) - next;
     }
     for (int k = 0; k < layout_.knots; ++k) {
       g[layout_.defects() + k] = car_bus_phi(problem_.scenario(), state(z, k));
@@ -114,7 +116,7 @@ class CarBusNlp : public Ipopt::TNLP {
       Eigen::MatrixXd A, B;
       if (values != nullptr) problem_.dynamics(state(z, k), control(z, k), next, A, B);
       for (int i = 0; i < kState; ++i) {
-        const int row = kState * k + i;
+        const std::ptrdiff_t row = layout_.state(k) + i;
         add(rows, cols, values, entry, row, layout_.state(k + 1) + i, 1.0);
         for (int j = 0; j < kState; ++j) {
           add(rows, cols, values, entry, row, layout_.state(k) + j, values ? -A(i, j) : 0.0);
@@ -176,11 +178,11 @@ class CarBusNlp : public Ipopt::TNLP {
     return total;
   }
 
-  static void add(Index* rows, Index* cols, Number* values, int& entry, int row, int col,
-                  double value) {
+  static void add(Index* rows, Index* cols, Number* values, int& entry, std::ptrdiff_t row,
+                  std::ptrdiff_t col, double value) {
     if (values == nullptr) {
-      rows[entry] = row;
-      cols[entry] = col;
+      rows[entry] = static_cast<Index>(row);
+      cols[entry] = static_cast<Index>(col);
     } else {
       values[entry] = value;
     }

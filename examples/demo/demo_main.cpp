@@ -175,9 +175,7 @@ void write_scene_svg(const std::filesystem::path& path) {
   std::ofstream(path) << svg.str();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   const std::filesystem::path out_dir = argc > 1 ? argv[1] : "out";
   std::filesystem::create_directories(out_dir);
 
@@ -204,4 +202,15 @@ int main(int argc, char** argv) {
             << " (collides)\nfigures and data in " << out_dir.string()
             << "/: car_bus.svg car_bus.csv car_bus.json scene.svg\n";
   return run.result.status == trajopt::AltroStatus::kSolved ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& error) {  // an unwritable folder, a solver that threw
+    std::cerr << "diffpills_demo: " << error.what() << "\n";
+    return 1;
+  }
 }

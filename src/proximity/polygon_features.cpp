@@ -60,7 +60,7 @@ bool overlap_centre(const PaddedPolygon& polygon, const std::vector<Eigen::Vecto
       const double da = n.dot(a) - offsets(j), db = n.dot(b) - offsets(j);
       if (da <= 0.0) next.push_back(a);
       if ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
-        next.push_back(a + (da / (da - db)) * (b - a));
+        next.emplace_back(a + (da / (da - db)) * (b - a));
       }
     }
     region.swap(next);

@@ -101,7 +101,7 @@ std::array<CoreSolution, 2> solve_polygon_polygon(const PaddedPolygon& a, const 
 
   if (b_normal.head<2>().norm() <= 1e-12) {
     std::vector<Eigen::Vector2d> shadow;  // B's outline seen from A's normal, counterclockwise
-    for (Eigen::Index j = 0; j < kb; ++j) shadow.push_back(W[j].head<2>());
+    for (Eigen::Index j = 0; j < kb; ++j) shadow.emplace_back(W[j].head<2>());
     if (b_normal.z() < 0.0) std::reverse(shadow.begin(), shadow.end());
     Eigen::Vector2d centre;
     if (overlap_centre(a, shadow, centre)) {

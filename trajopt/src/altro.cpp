@@ -86,6 +86,11 @@ class Solver {
   bool backward_pass(const Rollout& r);
   bool forward_pass(const VectorXd& x0, Rollout& r, double& cost);
   void update_multipliers(const Rollout& r);
+  // rho <- rho * growth after a failed factorization or line search; false once past the cap.
+  bool grow_regularization() {
+    rho_ = std::max(rho_ * settings_.regularization_growth, settings_.regularization_min);
+    return rho_ <= settings_.regularization_max;
+  }
 
   const Problem& problem_;
   const AltroSettings& settings_;
@@ -253,8 +258,7 @@ AltroResult Solver::run(const VectorXd& x0, const std::vector<VectorXd>& control
          ++inner) {
       ++iterations_;
       if (!backward_pass(r)) {
-        rho_ = std::max(rho_ * settings_.regularization_growth, settings_.regularization_min);
-        if (rho_ > settings_.regularization_max) {
+        if (!grow_regularization()) {
           result.status = AltroStatus::kRegularizationFailure;
           break;
         }
@@ -273,8 +277,7 @@ AltroResult Solver::run(const VectorXd& x0, const std::vector<VectorXd>& control
       }
       const double before = cost;
       if (!forward_pass(x0, r, cost)) {
-        rho_ = std::max(rho_ * settings_.regularization_growth, settings_.regularization_min);
-        if (rho_ > settings_.regularization_max) {
+        if (!grow_regularization()) {
           result.status = AltroStatus::kRegularizationFailure;
           break;
         }
