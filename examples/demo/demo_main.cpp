@@ -96,6 +96,7 @@ void write_car_bus_json(const examples::CarBusProblem& problem, const CarBusRun&
                       {"status", trajopt::to_string(run.result.status)},
                       {"iterations", run.result.iterations},
                       {"outer_iterations", run.result.outer_iterations},
+                      {"polish_iterations", run.result.polish_iterations},
                       {"max_violation", run.result.max_violation},
                       {"cost", run.result.cost},
                       {"solve_ms", run.solve_ms}}},

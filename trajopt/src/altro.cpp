@@ -1,6 +1,8 @@
 #include "diffpills/trajopt/altro.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -86,6 +88,8 @@ class Solver {
   bool backward_pass(const Rollout& r);
   bool forward_pass(const VectorXd& x0, Rollout& r, double& cost);
   void update_multipliers(const Rollout& r);
+  double total_violation(const VectorXd& x0, const Rollout& r) const;
+  int polish(const VectorXd& x0, Rollout& r) const;
   // rho <- rho * growth after a failed factorization or line search; false once past the cap.
   bool grow_regularization() {
     rho_ = std::max(rho_ * settings_.regularization_growth, settings_.regularization_min);
@@ -221,6 +225,96 @@ void Solver::update_multipliers(const Rollout& r) {
   multipliers_.mu = std::min(multipliers_.mu * settings_.penalty_scaling, settings_.penalty_max);
 }
 
+// The largest violation of anything the solution must satisfy: the problem's constraints, the
+// initial state and the dynamics (exact after a rollout, not after a polish).
+double Solver::total_violation(const VectorXd& x0, const Rollout& r) const {
+  double worst = std::max(max_violation(r), (r.x[0] - x0).lpNorm<Eigen::Infinity>());
+  for (int k = 0; k + 1 < n_; ++k) {
+    VectorXd next;
+    MatrixXd A, B;
+    problem_.dynamics(r.x[k], r.u[k], next, A, B);
+    worst = std::max(worst, (r.x[k + 1] - next).lpNorm<Eigen::Infinity>());
+  }
+  return worst;
+}
+
+// Projected Newton on z = [x_0 .. x_{N-1}, u_0 .. u_{N-2}]: with c(z) the stacked active
+// constraints (x_0 - x0, x_{k+1} - f(x_k, u_k), equalities, inequalities that carry a multiplier
+// or are violated) and D = dc/dz, the minimum-norm Gauss-Newton step to c + D dz = 0 is
+//   dz = -D'(D D')^-1 c.
+// D D' is banded (each dynamics row touches two knots); Eigen's sparse LDLT factors it, with a
+// diagonal shift of 1e-12 of its size in case active rows are dependent. A step is taken whole or
+// halved up to five times, and only if it lowers total_violation. Returns the accepted steps.
+int Solver::polish(const VectorXd& x0, Rollout& r) const {
+  const int nx = problem_.state_size();
+  const int nu = problem_.control_size();
+  const auto x_index = [&](int k) { return static_cast<Eigen::Index>(k) * nx; };
+  const auto u_index = [&](int k) {
+    return static_cast<Eigen::Index>(n_) * nx + static_cast<Eigen::Index>(k) * nu;
+  };
+  const Eigen::Index variables = u_index(n_ - 1);
+  int accepted = 0;
+  for (int iteration = 0; iteration < settings_.polish_iterations; ++iteration) {
+    const double current = total_violation(x0, r);
+    if (current <= settings_.polish_tolerance) break;
+    std::vector<Eigen::Triplet<double>> entries;
+    std::vector<double> values;
+    const auto add_row = [&](double value) {
+      values.push_back(value);
+      return static_cast<Eigen::Index>(values.size()) - 1;
+    };
+    for (int i = 0; i < nx; ++i) {
+      entries.emplace_back(add_row(r.x[0](i) - x0(i)), x_index(0) + i, 1.0);
+    }
+    for (int k = 0; k + 1 < n_; ++k) {
+      VectorXd next;
+      MatrixXd A, B;
+      problem_.dynamics(r.x[k], r.u[k], next, A, B);
+      for (int i = 0; i < nx; ++i) {
+        const Eigen::Index row = add_row(r.x[k + 1](i) - next(i));
+        entries.emplace_back(row, x_index(k + 1) + i, 1.0);
+        for (int j = 0; j < nx; ++j) entries.emplace_back(row, x_index(k) + j, -A(i, j));
+        for (int j = 0; j < nu; ++j) entries.emplace_back(row, u_index(k) + j, -B(i, j));
+      }
+    }
+    for (int k = 0; k < n_; ++k) {
+      const KnotConstraints c = problem_.constraints(k, r.x[k], control(r, k));
+      for (Eigen::Index i = 0; i < c.value.size(); ++i) {
+        if (i >= c.equalities && c.value(i) <= 0.0 && multipliers_.lambda[k](i) <= 0.0) continue;
+        const Eigen::Index row = add_row(c.value(i));
+        for (int j = 0; j < nx; ++j) entries.emplace_back(row, x_index(k) + j, c.dx(i, j));
+        for (Eigen::Index j = 0; j < c.du.cols(); ++j) {
+          entries.emplace_back(row, u_index(k) + j, c.du(i, j));
+        }
+      }
+    }
+    const auto rows = static_cast<Eigen::Index>(values.size());
+    Eigen::SparseMatrix<double> D(rows, variables);
+    D.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SparseMatrix<double> normal = D * D.transpose();
+    double size = 0.0;
+    for (Eigen::Index i = 0; i < rows; ++i) size = std::max(size, normal.coeff(i, i));
+    for (Eigen::Index i = 0; i < rows; ++i) normal.coeffRef(i, i) += 1e-12 * (1.0 + size);
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);
+    if (ldlt.info() != Eigen::Success) break;
+    const VectorXd step =
+        -(D.transpose() * ldlt.solve(Eigen::Map<const VectorXd>(values.data(), rows))).eval();
+    bool improved = false;
+    for (double fraction = 1.0; fraction > 0.03 && !improved; fraction *= 0.5) {
+      Rollout trial = r;
+      for (int k = 0; k < n_; ++k) trial.x[k] += fraction * step.segment(x_index(k), nx);
+      for (int k = 0; k + 1 < n_; ++k) trial.u[k] += fraction * step.segment(u_index(k), nu);
+      if (total_violation(x0, trial) < current) {
+        r = std::move(trial);
+        improved = true;
+      }
+    }
+    if (!improved) break;
+    ++accepted;
+  }
+  return accepted;
+}
+
 AltroResult Solver::run(const VectorXd& x0, const std::vector<VectorXd>& controls) {
   const int nx = problem_.state_size();
   const int nu = problem_.control_size();
@@ -298,10 +392,13 @@ AltroResult Solver::run(const VectorXd& x0, const std::vector<VectorXd>& control
     if (iterations_ >= settings_.max_total_iterations) break;
     update_multipliers(r);
   }
+  if (settings_.polish && result.status == AltroStatus::kSolved) {
+    result.polish_iterations = polish(x0, r);
+  }
   result.states = r.x;
   result.controls = r.u;
   result.cost = problem_cost(r);
-  result.max_violation = max_violation(r);
+  result.max_violation = total_violation(x0, r);
   result.iterations = iterations_;
   return result;
 }

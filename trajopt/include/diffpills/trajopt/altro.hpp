@@ -8,6 +8,11 @@
 // Inner loop: iLQR on that cost. The backward pass regularizes Quu + rho I, with rho grown by 1.6
 // on a failed factorization or line search and kept in [1e-8, 1e8]; the forward pass backtracks
 // from a full step and accepts when actual / expected decrease lies in [1e-8, 10].
+// Projected-Newton polish (ALTRO's last stage): once the augmented Lagrangian has converged, the
+// active constraints (the initial state, the dynamics, equalities, inequalities with a multiplier
+// or a violation) are driven to zero by Gauss-Newton projections of all states and controls,
+// dz = -D'(D D')^-1 c, each accepted only if it lowers the largest violation. The states then
+// satisfy the dynamics to the polish tolerance instead of exactly, as a rollout would.
 // Every loop has a cap; the result says how it ended.
 #pragma once
 
@@ -35,6 +40,9 @@ struct AltroSettings {
   double line_search_lower = 1e-8;
   double line_search_upper = 10.0;
   int line_search_steps = 20;
+  bool polish = true;
+  int polish_iterations = 10;
+  double polish_tolerance = 1e-10;  // largest violation, dynamics defects included
 };
 
 enum class AltroStatus {
@@ -50,9 +58,10 @@ struct AltroResult {
   std::vector<Eigen::VectorXd> controls;  // N - 1
   AltroStatus status = AltroStatus::kMaxIterations;
   double cost = 0.0;           // the problem's cost, without constraint terms
-  double max_violation = 0.0;  // largest equality |e| or positive inequality c
+  double max_violation = 0.0;  // largest equality |e|, positive inequality c or dynamics defect
   int iterations = 0;          // iLQR iterations, over all outer iterations
   int outer_iterations = 0;
+  int polish_iterations = 0;   // accepted projected-Newton steps
 };
 
 // Solves from x0 with the controls as the initial guess (N - 1 of them; the states follow by
