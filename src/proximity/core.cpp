@@ -4,7 +4,6 @@ namespace diffpills::detail {
 
 Core make_core(const Capsule& capsule) {
   Core core;
-  core.radius = capsule.radius();
   core.size = capsule.length();
   if (capsule.length() == 0.0) {
     return core;  // a sphere: the core is the body origin
@@ -22,7 +21,6 @@ Core make_core(const Capsule& capsule) {
 Core make_core(const PaddedPolygon& polygon) {
   Core core;
   core.dim = 2;
-  core.radius = polygon.radius();
   core.size = polygon.extent();
   core.U(0, 0) = polygon.extent();
   core.U(1, 1) = polygon.extent();

@@ -24,7 +24,6 @@ struct Core {
   Eigen::Vector3d u0 = Eigen::Vector3d::Zero();
   Eigen::MatrixXd G;  // constraint rows, dim columns
   Eigen::VectorXd h;
-  double radius = 0.0;
   double size = 0.0;  // length scale: the capsule's length or the polygon's extent
 };
 
