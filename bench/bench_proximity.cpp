@@ -19,6 +19,7 @@
 #include "car_bus/car_bus.hpp"
 #include "car_bus/car_bus_ipopt.hpp"
 #include "diffpills/diffpills.hpp"
+#include "quadrotor_window/quadrotor_window.hpp"
 
 namespace {
 
@@ -214,7 +215,16 @@ void CarBus_Ipopt(benchmark::State& state) {
     benchmark::DoNotOptimize(examples::solve_with_ipopt(problem, guess).cost);
   }
 }
+// The 3-D problem of issue 4 (target <= 200 ms): 13 states, 4 thrusts, 51 knots, six obstacles.
+void QuadrotorWindow_Altro(benchmark::State& state) {
+  const examples::QuadrotorWindowProblem problem{examples::QuadrotorWindowScenario{}};
+  const std::vector<Eigen::VectorXd> guess = problem.hover_controls();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(trajopt::solve(problem, problem.scenario().x0, guess));
+  }
+}
 BENCHMARK(CarBus_Altro)->Unit(benchmark::kMillisecond);
+BENCHMARK(QuadrotorWindow_Altro)->Unit(benchmark::kMillisecond);
 BENCHMARK(CarBus_Ipopt)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(CapsuleCapsule_FclDistance);

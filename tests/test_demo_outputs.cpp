@@ -52,7 +52,33 @@ TEST(DemoOutputs, FilesParseAndCarryTheScenario) {
   EXPECT_EQ(rows, scenario["N"].get<int>());
   EXPECT_EQ(last.substr(last.size() - 2), ",,");  // the last knot has no controls
 
-  for (const char* figure : {"car_bus.svg", "scene.svg"}) {
+  const nlohmann::json flight = nlohmann::json::parse(read(out / "quadrotor_window.json"));
+  for (const char* key : {"dt", "N", "quadrotor", "window", "wall", "poles", "x0", "goal",
+                          "level_straight_line_min_phi", "min_phi", "largest_tilt_deg", "solver"}) {
+    EXPECT_TRUE(flight.contains(key)) << key;
+  }
+  EXPECT_EQ(flight["wall"].size(), 4u);
+  for (const auto& panel : flight["wall"]) {
+    EXPECT_EQ(panel["type"], "polygon");
+    for (const char* key : {"C", "d", "radius", "r", "q"}) EXPECT_TRUE(panel.contains(key)) << key;
+  }
+  for (const auto& pole : flight["poles"]) EXPECT_EQ(pole["type"], "capsule");
+  EXPECT_LT(flight["level_straight_line_min_phi"].get<double>(), 0.0);
+  EXPECT_GE(flight["min_phi"].get<double>(), -1e-6);
+  EXPECT_LE(flight["solver"]["max_violation"].get<double>(), 1e-6);
+
+  std::istringstream flight_csv(read(out / "quadrotor_window.csv"));
+  std::getline(flight_csv, line);
+  EXPECT_EQ(line, "k,t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,u1,u2,u3,u4");
+  rows = 0;
+  while (std::getline(flight_csv, line)) {
+    ++rows;
+    last = line;
+  }
+  EXPECT_EQ(rows, flight["N"].get<int>());
+  EXPECT_EQ(last.substr(last.size() - 4), ",,,,");
+
+  for (const char* figure : {"car_bus.svg", "quadrotor_window.svg", "scene.svg"}) {
     const std::string svg = read(out / figure);
     EXPECT_EQ(svg.rfind("<svg", 0), 0u) << figure;
     EXPECT_NE(svg.find("</svg>"), std::string::npos) << figure;

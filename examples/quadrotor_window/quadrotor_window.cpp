@@ -1,0 +1,204 @@
+#include "quadrotor_window.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace diffpills::examples {
+
+namespace {
+
+// A rectangle [s0, s1] x [t0, t1] of the wall, padded by radius: s runs across the window, t
+// along it, and the wall is the plane x = centre.x turned by tilt about the world x axis, so that
+// before the tilt s is world y and t world z. The panel's body frame is the world's turned by +90
+// degrees about y (body z = world x, body x = -t, body y = s), then by the tilt, centred on the
+// rectangle so that the polygon contains its origin.
+PosedPolygon wall_panel(const Eigen::Vector3d& centre, double tilt, double s0, double s1, double t0,
+                        double t1, double radius) {
+  Eigen::MatrixX2d C(4, 2);
+  C << 1.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, -1.0;
+  const double half_t = 0.5 * (t1 - t0), half_s = 0.5 * (s1 - s0);
+  Eigen::VectorXd d(4);
+  d << half_t, half_t, half_s, half_s;
+  const Eigen::Quaterniond rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX())) *
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * M_PI, Eigen::Vector3d::UnitY()));
+  const Eigen::Vector3d offset = rotation * Eigen::Vector3d(-0.5 * (t0 + t1), 0.5 * (s0 + s1), 0.0);
+  return {PaddedPolygon(C, d, radius),
+          Pose(centre + offset,
+               Eigen::Vector4d(rotation.w(), rotation.x(), rotation.y(), rotation.z()))};
+}
+
+// A vertical pole: the capsule's core (body x) turned by -90 degrees about y onto world z.
+PosedCapsule pole(double x, double y, double height, double radius) {
+  const double c = std::sqrt(0.5);
+  return {Capsule(height, radius),
+          Pose(Eigen::Vector3d(x, y, 0.5 * height), Eigen::Vector4d(c, 0.0, -c, 0.0))};
+}
+
+Eigen::VectorXd hover_state(double x, double y, double z) {
+  Eigen::VectorXd state = Eigen::VectorXd::Zero(13);
+  state.head<3>() << x, y, z;
+  state(3) = 1.0;
+  return state;
+}
+
+// A square of the given half-side in the body xy-plane, padded by radius.
+PaddedPolygon padded_square(double half_side, double radius) {
+  Eigen::MatrixX2d C(4, 2);
+  C << 1.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, -1.0;
+  return PaddedPolygon(C, Eigen::Vector4d::Constant(half_side), radius);
+}
+
+}  // namespace
+
+// The wall is a 3 m square of four panels 0.3 m thick (radius 0.15) around the window, whose
+// padded surfaces bound the window exactly: window_width across, window_height along, the whole
+// turned by window_tilt about x. The body (half-side 0.2, radius 0.1) is 0.6 m wide and fits the
+// 0.45 m gap only when its plane crosses the window steeply: rolled by alpha, its extent across
+// the window is 0.4 |cos(alpha - tilt)| + 0.2 < 0.45, i.e. |alpha - tilt| > acos(0.625) ~ 51 deg,
+// a roll beyond -21 deg for the 30 deg tilt.
+// Two numerical choices make the problem well posed for a local method:
+// - The tilt makes phi's derivative with respect to the roll nonzero when level; an upright slot
+//   is a symmetric saddle there and iLQR never starts rolling.
+// - phi's gradient vanishes once the cores intersect (proximity.hpp), which happens when an iterate
+//   penetrates deeper than the sum of the radii; with 0.05 m panels and body padding, early AL
+//   iterates got stuck at phi = -(R1 + R2)^2 for some horizons. The padding here (0.25 m in sum)
+//   keeps every horizon from 31 to 81 knots solvable (measured).
+QuadrotorWindowScenario::QuadrotorWindowScenario()
+    : body(padded_square(body_half_side, body_radius)),
+      x0(hover_state(0.0, 0.0, 1.5)),
+      goal(hover_state(6.0, 0.0, 1.5)) {
+  const double radius = wall_radius, half_wall = wall_half_size;
+  const double half_gap = 0.5 * window_width + radius, half_height = 0.5 * window_height + radius;
+  wall = {
+      wall_panel(window_centre, window_tilt, -half_wall, -half_gap, -half_wall, half_wall, radius),
+      wall_panel(window_centre, window_tilt, half_gap, half_wall, -half_wall, half_wall, radius),
+      wall_panel(window_centre, window_tilt, -half_gap, half_gap, -half_wall, -half_height, radius),
+      wall_panel(window_centre, window_tilt, -half_gap, half_gap, half_height, half_wall, radius)};
+  poles = {pole(1.5, 0.2, 3.0, 0.1), pole(4.5, -0.2, 3.0, 0.1)};
+}
+
+Pose quadrotor_pose(const Eigen::VectorXd& x) { return Pose(x.head<3>(), x.segment<4>(3)); }
+
+double quadrotor_min_phi(const QuadrotorWindowScenario& scenario, const Eigen::VectorXd& x) {
+  const Pose pose = quadrotor_pose(x);
+  double smallest = INFINITY;
+  for (const PosedPolygon& panel : scenario.wall) {
+    smallest = std::min(smallest, proximity(scenario.body, pose, panel.shape, panel.pose).phi);
+  }
+  for (const PosedCapsule& p : scenario.poles) {
+    smallest = std::min(smallest, proximity(scenario.body, pose, p.shape, p.pose).phi);
+  }
+  return smallest;
+}
+
+QuadrotorWindowProblem::QuadrotorWindowProblem(QuadrotorWindowScenario scenario)
+    : scenario_(std::move(scenario)) {
+  hover_ = Eigen::Vector4d::Constant(scenario_.model.hover_thrust());
+  Eigen::VectorXd q(13), qf(13);
+  // position, attitude, velocity, angular velocity
+  q << 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01;
+  qf << 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 1, 1, 1;
+  Q_ = q.asDiagonal();
+  Qf_ = qf.asDiagonal();
+  R_ = 0.1 * Eigen::MatrixXd::Identity(4, 4);
+}
+
+int QuadrotorWindowProblem::obstacle_count() const {
+  return static_cast<int>(scenario_.wall.size() + scenario_.poles.size());
+}
+
+void QuadrotorWindowProblem::dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                      Eigen::VectorXd& next, Eigen::MatrixXd& A,
+                                      Eigen::MatrixXd& B) const {
+  trajopt::Quadrotor::State fixed_next;
+  trajopt::Quadrotor::StateMatrix fixed_A;
+  trajopt::Quadrotor::ControlMatrix fixed_B;
+  scenario_.model.step(scenario_.dt, x, u, fixed_next, fixed_A, fixed_B);
+  next = fixed_next;
+  A = fixed_A;
+  B = fixed_B;
+}
+
+trajopt::CostExpansion QuadrotorWindowProblem::stage_cost(int, const Eigen::VectorXd& x,
+                                                          const Eigen::VectorXd& u) const {
+  const Eigen::VectorXd e = x - scenario_.goal, du = u - hover_;
+  return {0.5 * e.dot(Q_ * e) + 0.5 * du.dot(R_ * du),
+          Q_ * e,
+          R_ * du,
+          Q_,
+          R_,
+          Eigen::MatrixXd::Zero(4, 13)};
+}
+
+trajopt::CostExpansion QuadrotorWindowProblem::terminal_cost(const Eigen::VectorXd& x) const {
+  const Eigen::VectorXd e = x - scenario_.goal;
+  return {0.5 * e.dot(Qf_ * e), Qf_ * e,          Eigen::VectorXd(), Qf_,
+          Eigen::MatrixXd(),    Eigen::MatrixXd()};
+}
+
+trajopt::KnotConstraints QuadrotorWindowProblem::constraints(int k, const Eigen::VectorXd& x,
+                                                             const Eigen::VectorXd& u) const {
+  return evaluate_constraints(k, x, u, true);
+}
+
+trajopt::KnotConstraints QuadrotorWindowProblem::constraint_values(int k, const Eigen::VectorXd& x,
+                                                                   const Eigen::VectorXd& u) const {
+  return evaluate_constraints(k, x, u, false);
+}
+
+// Rows: [equalities: r - goal position (last knot only)], -phi per obstacle (wall panels, then
+// poles), then u - thrust_max and -u. d(-phi)/dx takes the proximity gradient's first seven
+// entries (d/dr, d/dq of the body, the first shape) as they are: q is the state's own quaternion,
+// and the library's gradient already includes the normalization of q.
+trajopt::KnotConstraints QuadrotorWindowProblem::evaluate_constraints(int k,
+                                                                      const Eigen::VectorXd& x,
+                                                                      const Eigen::VectorXd& u,
+                                                                      bool derivatives) const {
+  const bool last = k == scenario_.knots - 1;
+  const int equalities = last ? 3 : 0;
+  const int obstacles = obstacle_count();
+  const int rows = equalities + obstacles + (last ? 0 : 8);
+  trajopt::KnotConstraints c;
+  c.equalities = equalities;
+  c.value = Eigen::VectorXd::Zero(rows);
+  if (derivatives) {
+    c.dx = Eigen::MatrixXd::Zero(rows, 13);
+    c.du = Eigen::MatrixXd::Zero(rows, last ? 0 : 4);
+  }
+  if (last) {
+    c.value.head<3>() = x.head<3>() - scenario_.goal.head<3>();
+    if (derivatives) c.dx.topLeftCorner<3, 3>().setIdentity();
+  }
+  const Pose pose = quadrotor_pose(x);
+  int row = equalities;
+  const auto add = [&](const Proximity& p) {
+    c.value(row) = -p.phi;
+    if (derivatives) c.dx.row(row).head<7>() = -p.gradient.head<7>().transpose();
+    ++row;
+  };
+  for (const PosedPolygon& panel : scenario_.wall) {
+    add(proximity(scenario_.body, pose, panel.shape, panel.pose));
+  }
+  for (const PosedCapsule& p : scenario_.poles) {
+    add(proximity(scenario_.body, pose, p.shape, p.pose));
+  }
+  if (!last) {
+    for (int i = 0; i < 4; ++i) {
+      c.value(row + i) = u(i) - scenario_.thrust_max;
+      c.value(row + 4 + i) = -u(i);
+      if (derivatives) {
+        c.du(row + i, i) = 1.0;
+        c.du(row + 4 + i, i) = -1.0;
+      }
+    }
+  }
+  return c;
+}
+
+std::vector<Eigen::VectorXd> QuadrotorWindowProblem::hover_controls() const {
+  return std::vector<Eigen::VectorXd>(scenario_.knots - 1, hover_);
+}
+
+}  // namespace diffpills::examples

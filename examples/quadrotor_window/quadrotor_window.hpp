@@ -1,0 +1,91 @@
+// Beyond the paper, in 3-D: a quadrotor whose body is a padded square flies through a window in a
+// wall of padded polygons. The window is narrower than the quadrotor is wide, so it has to roll to
+// pass, and the window is tilted, as in the aggressive-flight experiments this mimics; two capsule
+// poles stand on the way, one before and one after the wall. Every knot carries
+// phi(body, obstacle) >= 0 for each of the wall's four panels (polygon-polygon) and each pole
+// (polygon-capsule), with gradients with respect to the body's quaternion, which is part of the
+// state.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "diffpills/diffpills.hpp"
+#include "diffpills/trajopt/altro.hpp"
+#include "diffpills/trajopt/quadrotor.hpp"
+
+namespace diffpills::examples {
+
+struct PosedPolygon {
+  PaddedPolygon shape;
+  Pose pose;
+};
+
+struct PosedCapsule {
+  Capsule shape;
+  Pose pose;
+};
+
+struct QuadrotorWindowScenario {
+  QuadrotorWindowScenario();
+
+  double dt = 0.06;
+  int knots = 51;  // 3 s
+  trajopt::Quadrotor model;
+  double body_half_side = 0.2;  // the quadrotor's padded square in its body xy-plane
+  double body_radius = 0.1;
+  double wall_radius = 0.15;    // half the wall's thickness
+  double wall_half_size = 1.5;  // the wall is a square of this half-size around the window
+  Eigen::Vector3d window_centre{3.0, 0.0, 1.5};  // the wall is the plane x = 3 through it
+  double window_width = 0.45;   // clear gap across the window, between the padded panels
+  double window_height = 1.0;   // clear gap along the window
+  double window_tilt = 0.5236;  // rad (30 deg) about the world x axis, from upright
+  // Built by the constructor from the fields above.
+  PaddedPolygon body;
+  std::vector<PosedPolygon> wall;  // left, right, bottom, top panels
+  std::vector<PosedCapsule> poles;
+  Eigen::VectorXd x0, goal;  // hover states (13)
+  double thrust_max = 4.0;   // per rotor, N; thrusts are >= 0
+};
+
+// The body's pose at state x: r = x[0:3], q = x[3:7].
+Pose quadrotor_pose(const Eigen::VectorXd& x);
+
+// The smallest phi over the obstacles at state x.
+double quadrotor_min_phi(const QuadrotorWindowScenario& scenario, const Eigen::VectorXd& x);
+
+// Costs 1/2 (x - goal)'Q(x - goal) + 1/2 (u - hover)'R(u - hover) per knot and
+// 1/2 (x - goal)'Qf(x - goal) at the end; constraints -phi <= 0 for every obstacle at every knot,
+// 0 <= u <= thrust_max, and the final position equal to the goal's.
+class QuadrotorWindowProblem : public trajopt::Problem {
+ public:
+  explicit QuadrotorWindowProblem(QuadrotorWindowScenario scenario);
+
+  int state_size() const override { return 13; }
+  int control_size() const override { return 4; }
+  int knots() const override { return scenario_.knots; }
+  void dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& next,
+                Eigen::MatrixXd& A, Eigen::MatrixXd& B) const override;
+  trajopt::CostExpansion stage_cost(int k, const Eigen::VectorXd& x,
+                                    const Eigen::VectorXd& u) const override;
+  trajopt::CostExpansion terminal_cost(const Eigen::VectorXd& x) const override;
+  trajopt::KnotConstraints constraints(int k, const Eigen::VectorXd& x,
+                                       const Eigen::VectorXd& u) const override;
+  trajopt::KnotConstraints constraint_values(int k, const Eigen::VectorXd& x,
+                                             const Eigen::VectorXd& u) const override;
+
+  const QuadrotorWindowScenario& scenario() const { return scenario_; }
+  int obstacle_count() const;
+  // Hover thrust at every step: the quadrotor stays where it starts.
+  std::vector<Eigen::VectorXd> hover_controls() const;
+
+ private:
+  trajopt::KnotConstraints evaluate_constraints(int k, const Eigen::VectorXd& x,
+                                                const Eigen::VectorXd& u, bool derivatives) const;
+
+  QuadrotorWindowScenario scenario_;
+  Eigen::VectorXd hover_;
+  Eigen::MatrixXd Q_, R_, Qf_;
+};
+
+}  // namespace diffpills::examples
