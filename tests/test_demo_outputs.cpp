@@ -1,13 +1,19 @@
 // `make demo`'s files parse and carry what the motion-planning issue promises: runs the demo
-// program (its path is the first argument) into a fresh folder and reads everything back.
+// program (its path is the first argument) into a fresh folder and reads everything back, then
+// checks that each CSV row follows from the previous one by RK4 of the documented model, with the
+// parameters the JSON files state.
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -20,10 +26,92 @@ std::string read(const std::filesystem::path& path) {
   return buffer.str();
 }
 
+// Runs the demo once into a fresh folder; both tests read it.
+const std::filesystem::path& demo_folder() {
+  static const std::filesystem::path out = [] {
+    const std::filesystem::path folder =
+        std::filesystem::temp_directory_path() / "diffpills_demo_test";
+    std::filesystem::remove_all(folder);
+    const int status = std::system((demo_program + " " + folder.string() + " > /dev/null").c_str());
+    EXPECT_EQ(status, 0);
+    return folder;
+  }();
+  return out;
+}
+
+// The CSV's numeric rows (k, t, state..., controls...), the last without controls.
+std::vector<Eigen::VectorXd> csv_rows(const std::filesystem::path& path) {
+  std::istringstream csv(read(path));
+  std::string line;
+  std::getline(csv, line);  // header
+  std::vector<Eigen::VectorXd> rows;
+  while (std::getline(csv, line)) {
+    std::vector<double> values;
+    std::istringstream cells(line);
+    std::string cell;
+    while (std::getline(cells, cell, ',')) {
+      if (!cell.empty()) values.push_back(std::stod(cell));
+    }
+    rows.push_back(
+        Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())));
+  }
+  return rows;
+}
+
+template <class Rate>
+Eigen::VectorXd rk4(const Rate& rate, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                    double h) {
+  const Eigen::VectorXd k1 = rate(x, u), k2 = rate(x + 0.5 * h * k1, u),
+                        k3 = rate(x + 0.5 * h * k2, u), k4 = rate(x + h * k3, u);
+  return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+}
+
+TEST(DemoOutputs, CsvRowsFollowRk4OfTheDocumentedModels) {
+  const std::filesystem::path& out = demo_folder();
+  {  // the kinematic bicycle of README / trajopt/car.hpp
+    const nlohmann::json scenario = nlohmann::json::parse(read(out / "car_bus.json"));
+    const double dt = scenario["dt"], l = scenario["wheelbase"];
+    const auto rate = [l](const Eigen::VectorXd& x, const Eigen::VectorXd& u) {
+      Eigen::VectorXd xdot(5);
+      xdot << x(3) * std::cos(x(2)), x(3) * std::sin(x(2)), x(3) * std::tan(x(4)) / l, u(0), u(1);
+      return xdot;
+    };
+    const std::vector<Eigen::VectorXd> rows = csv_rows(out / "car_bus.csv");
+    for (std::size_t k = 0; k + 1 < rows.size(); ++k) {
+      const Eigen::VectorXd next = rk4(rate, rows[k].segment(2, 5), rows[k].segment(7, 2), dt);
+      EXPECT_LE((next - rows[k + 1].segment(2, 5)).norm(), 1e-9) << "car_bus row " << k;
+    }
+  }
+  {  // the quadrotor of trajopt/quadrotor.hpp: RK4, then q normalized
+    const nlohmann::json scenario = nlohmann::json::parse(read(out / "quadrotor_window.json"));
+    const nlohmann::json& model = scenario["quadrotor"];
+    const double dt = scenario["dt"], m = model["mass"], arm = model["arm"],
+                 km = model["torque_per_thrust"], g = model["gravity"];
+    const Eigen::Vector3d J(model["inertia"][0], model["inertia"][1], model["inertia"][2]);
+    const auto rate = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& u) {
+      const Eigen::Quaterniond q(x(3), x(4), x(5), x(6));
+      const Eigen::Vector3d w = x.segment<3>(10);
+      const Eigen::Quaterniond spin = q * Eigen::Quaterniond(0.0, w(0), w(1), w(2));
+      const Eigen::Vector3d tau(arm * (u(1) - u(3)), arm * (u(2) - u(0)),
+                                km * (u(0) - u(1) + u(2) - u(3)));
+      Eigen::VectorXd xdot(13);
+      xdot.head<3>() = x.segment<3>(7);
+      xdot.segment<4>(3) << 0.5 * spin.w(), 0.5 * spin.x(), 0.5 * spin.y(), 0.5 * spin.z();
+      xdot.segment<3>(7) = q.toRotationMatrix().col(2) * u.sum() / m - Eigen::Vector3d(0, 0, g);
+      xdot.segment<3>(10) = (tau - w.cross(J.asDiagonal() * w)).cwiseQuotient(J);
+      return xdot;
+    };
+    const std::vector<Eigen::VectorXd> rows = csv_rows(out / "quadrotor_window.csv");
+    for (std::size_t k = 0; k + 1 < rows.size(); ++k) {
+      Eigen::VectorXd next = rk4(rate, rows[k].segment(2, 13), rows[k].segment(15, 4), dt);
+      next.segment<4>(3).normalize();
+      EXPECT_LE((next - rows[k + 1].segment(2, 13)).norm(), 1e-9) << "quadrotor row " << k;
+    }
+  }
+}
+
 TEST(DemoOutputs, FilesParseAndCarryTheScenario) {
-  const std::filesystem::path out = std::filesystem::temp_directory_path() / "diffpills_demo_test";
-  std::filesystem::remove_all(out);
-  ASSERT_EQ(std::system((demo_program + " " + out.string() + " > /dev/null").c_str()), 0);
+  const std::filesystem::path& out = demo_folder();
 
   const nlohmann::json scenario = nlohmann::json::parse(read(out / "car_bus.json"));
   for (const char* key :
@@ -83,7 +171,6 @@ TEST(DemoOutputs, FilesParseAndCarryTheScenario) {
     EXPECT_EQ(svg.rfind("<svg", 0), 0u) << figure;
     EXPECT_NE(svg.find("</svg>"), std::string::npos) << figure;
   }
-  std::filesystem::remove_all(out);
 }
 
 }  // namespace
