@@ -11,8 +11,12 @@ all: build
 deps:
 	@bash scripts/install-deps.sh
 
+# The Python package is built with Debian's interpreter (python3-numpy, python3-torch), not a
+# pyenv python3 earlier on PATH.
+PYTHON ?= /usr/bin/python3
+
 build: deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DDIFFPILLS_PYTHON=ON -DPython3_EXECUTABLE=$(PYTHON)
 	cmake --build $(BUILD) -j$(JOBS)
 
 # Every test, then the whole suite once more under AddressSanitizer + UndefinedBehaviorSanitizer.
@@ -27,9 +31,11 @@ test-sanitize: deps
 	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(SANITIZE_BUILD) --output-on-failure -LE no_sanitize
 
-# The motion-planning demo: solves the car-bus problem, writes out/*.csv, *.json, *.svg.
+# The motion-planning demo (car-bus and quadrotor-window problems: out/*.csv, *.json, *.svg), then
+# the Python example that untangles a heap of shapes (out/untangle_{before,after}.png).
 demo: build
 	./$(BUILD)/examples/diffpills_demo out
+	PYTHONPATH=$(BUILD)/python MPLBACKEND=Agg $(PYTHON) examples/python/untangle.py out
 
 bench: build
 	./$(BUILD)/bench/bench_proximity --benchmark_min_time=0.2

@@ -192,9 +192,38 @@ void run_batch(benchmark::State& state, const Shape& a, const Shape& b) {
 }
 
 void Batch_CapsuleCapsule(benchmark::State& s) { run_batch(s, kCapsuleA, kCapsuleB); }
+
+// The poses of bench/bench_python.py (a formula both languages evaluate identically), so that the
+// Python batch's overhead is measured against identical work here (issue 5: within 1.3x).
+void Batch_CapsuleCapsule_PythonPoses(benchmark::State& state) {
+  PositionArray r_a(kBatch, 3), r_b(kBatch, 3);
+  QuaternionArray q_a(kBatch, 4), q_b(kBatch, 4);
+  for (Eigen::Index k = 0; k < kBatch; ++k) {
+    const double i = static_cast<double>(k);
+    r_a.row(k) << 1.5 * std::sin(0.37 * i), 1.5 * std::cos(0.11 * i), 1.5 * std::sin(0.05 * i);
+    r_b.row(k) << 1.5 * std::cos(0.23 * i), 1.5 * std::sin(0.17 * i), 1.5 * std::cos(0.07 * i);
+    q_a.row(k) << std::cos(0.13 * i) + 0.1, std::sin(0.29 * i) + 0.1, std::cos(0.41 * i) + 0.1,
+        std::sin(0.07 * i) + 0.1;
+    q_b.row(k) << std::sin(0.19 * i) + 0.1, std::cos(0.31 * i) + 0.1, std::sin(0.43 * i) + 0.1,
+        std::cos(0.03 * i) + 0.1;
+  }
+  const BatchOptions options{static_cast<int>(state.range(0))};
+  Eigen::VectorXd phi(kBatch);
+  GradientArray gradient(kBatch, 14);
+  for (auto _ : state) {
+    proximity_batch(kCapsuleA, r_a, q_a, kCapsuleB, r_b, q_b, phi, gradient, options);
+    benchmark::DoNotOptimize(phi.data());
+  }
+  state.SetItemsProcessed(state.iterations() * kBatch);
+}
 void Batch_HexagonHexagon(benchmark::State& s) { run_batch(s, kHexagonA, kHexagonB); }
 
 BENCHMARK(Batch_CapsuleCapsule)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(Batch_CapsuleCapsule_PythonPoses)
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(Batch_HexagonHexagon)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // The motion-planning demo's problem, solved from its straight-line guess (issue 4's target:

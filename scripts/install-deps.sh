@@ -14,6 +14,9 @@ packages=(
   coinor-libipopt-dev    # NLP cross-check of the trajectory optimizer
   pkg-config             # finds Ipopt
   librsvg2-bin           # rsvg-convert: lets a person look at the demo's SVG figures as PNG
+  python3-dev pybind11-dev  # the Python bindings
+  python3-numpy python3-pytest python3-torch python3-matplotlib  # their tests and example
+  python3-venv python3-pip python3-setuptools  # the tested `pip install --no-build-isolation .`
 )
 
 missing=()

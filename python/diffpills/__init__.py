@@ -1,0 +1,43 @@
+"""diffpills: differentiable collision detection for capsules and padded polygons.
+
+Shapes: ``Capsule(length, radius)`` and ``PaddedPolygon(C, d, radius)``, each posed by
+``Pose(r, q)`` with ``q`` a quaternion ``[w, x, y, z]``. For any pair of shapes:
+
+``proximity(a, pose_a, b, pose_b)``
+    phi, closest points, normal and the gradient d phi / d[r_a, q_a, r_b, q_b] (14,).
+``proximity_jacobian(a, pose_a, b, pose_b)``
+    the same plus the Jacobians (6, 14) of the closest points.
+``proximity_batch(a, r_a, q_a, b, r_b, q_b, threads=0)``
+    phi (N,) and gradients (N, 14) for arrays of poses, on every core, without the GIL.
+
+``phi = ||p1 - p2||^2 - (R1 + R2)^2`` is negative exactly when the shapes overlap. Bad input raises
+ValueError naming the field. ``import diffpills.torch`` for ``diffpills.torch.proximity``, a
+PyTorch autograd function over batches (not imported here, so that ``import diffpills`` stays fast
+without PyTorch).
+"""
+
+from ._core import (
+    Capsule,
+    PaddedPolygon,
+    Pose,
+    Proximity,
+    ProximityJacobian,
+    SolverError,
+    __version__,
+    proximity,
+    proximity_batch,
+    proximity_jacobian,
+)
+
+__all__ = [
+    "Capsule",
+    "PaddedPolygon",
+    "Pose",
+    "Proximity",
+    "ProximityJacobian",
+    "SolverError",
+    "__version__",
+    "proximity",
+    "proximity_batch",
+    "proximity_jacobian",
+]

@@ -1,0 +1,100 @@
+"""PyTorch autograd for diffpills: ``diffpills.torch.proximity`` over batches of poses.
+
+    import torch, diffpills, diffpills.torch
+    capsule = diffpills.Capsule(1.0, 0.2)
+    r_a = torch.zeros(8, 3, requires_grad=True)
+    q_a = torch.tensor([[1.0, 0.0, 0.0, 0.0]]).repeat(8, 1)
+    phi = diffpills.torch.proximity(capsule, r_a, q_a, capsule, r_b, q_b)   # (8,)
+    torch.relu(-phi).sum().backward()                                      # r_a.grad, ...
+
+The forward pass is ``diffpills.proximity_batch`` on the CPU in float64; the backward pass
+multiplies the incoming gradient by the library's exact gradient of phi (no finite differences, no
+second derivatives: the function is once differentiable). Inputs may be float64 or float32, on any
+device; phi comes back in the inputs' dtype and on their device.
+"""
+
+import numpy as np
+import torch
+
+from . import _core
+
+__all__ = ["proximity"]
+
+
+def _as_numpy(tensor):
+    return np.ascontiguousarray(tensor.detach().to(device="cpu", dtype=torch.float64).numpy())
+
+
+class _Proximity(torch.autograd.Function):
+    """phi of N pose pairs, with backward through the analytic gradient."""
+
+    @staticmethod
+    def forward(ctx, a, b, threads, method, r_a, q_a, r_b, q_b):
+        phi, gradient = _core.proximity_batch(
+            a,
+            _as_numpy(r_a),
+            _as_numpy(q_a),
+            b,
+            _as_numpy(r_b),
+            _as_numpy(q_b),
+            threads=threads,
+            method=method,
+        )
+        ctx.save_for_backward(torch.from_numpy(gradient).to(device=r_a.device, dtype=r_a.dtype))
+        return torch.from_numpy(phi).to(device=r_a.device, dtype=r_a.dtype)
+
+    @staticmethod
+    @torch.autograd.function.once_differentiable
+    def backward(ctx, grad_phi):
+        (gradient,) = ctx.saved_tensors
+        weighted = gradient * grad_phi.unsqueeze(1)
+        return (
+            None,
+            None,
+            None,
+            None,
+            weighted[:, 0:3],
+            weighted[:, 3:7],
+            weighted[:, 7:10],
+            weighted[:, 10:14],
+        )
+
+
+def _rows(name, tensor, width):
+    if not isinstance(tensor, torch.Tensor):
+        raise TypeError(f"{name}: expected a torch.Tensor, got {type(tensor).__name__}")
+    if tensor.dim() == 1 and tensor.shape[0] == width:
+        return tensor.unsqueeze(0)
+    if tensor.dim() != 2 or tensor.shape[1] != width:
+        raise ValueError(
+            f"{name}: expected shape (N, {width}) or ({width},), got {tuple(tensor.shape)}"
+        )
+    return tensor
+
+
+def proximity(a, r_a, q_a, b, r_b, q_b, threads=0, method="default"):
+    """phi (N,) of shape ``a`` at poses (r_a[i], q_a[i]) and ``b`` at (r_b[i], q_b[i]).
+
+    a, b: ``diffpills.Capsule`` or ``diffpills.PaddedPolygon``.
+    r_a, r_b: (N, 3) tensors; q_a, q_b: (N, 4) quaternions [w, x, y, z] (need not be unit: they
+    are normalized inside, and the gradient includes that). Any of the four may be a single pose,
+    (3,) or (4,) or one row, shared by all N pairs (its gradient is then summed over the pairs).
+    All four must share one dtype (float64 or float32) and device.
+    Differentiable with respect to all four; the backward pass uses the exact gradient.
+    Raises ValueError for bad shapes or values (naming the argument and row).
+    """
+    r_a, q_a = _rows("r_a", r_a, 3), _rows("q_a", q_a, 4)
+    r_b, q_b = _rows("r_b", r_b, 3), _rows("q_b", q_b, 4)
+    tensors = {"r_a": r_a, "q_a": q_a, "r_b": r_b, "q_b": q_b}
+    for name, tensor in tensors.items():
+        if tensor.dtype not in (torch.float64, torch.float32):
+            raise ValueError(f"{name}: expected float64 or float32, got {tensor.dtype}")
+        if tensor.dtype != r_a.dtype or tensor.device != r_a.device:
+            raise ValueError(f"{name}: dtype and device must match r_a's")
+    n = max(t.shape[0] for t in tensors.values())
+    for name, tensor in tensors.items():
+        if tensor.shape[0] not in (1, n):
+            raise ValueError(f"{name}: has {tensor.shape[0]} rows, the others {n}")
+    # expand() is a view whose backward sums over the shared rows.
+    r_a, q_a, r_b, q_b = (t.expand(n, t.shape[1]) for t in (r_a, q_a, r_b, q_b))
+    return _Proximity.apply(a, b, threads, method, r_a, q_a, r_b, q_b)

@@ -1,0 +1,17 @@
+# Type stubs for diffpills.torch.
+from typing import Literal
+
+import torch
+
+from ._core import Shape
+
+def proximity(
+    a: Shape,
+    r_a: torch.Tensor,
+    q_a: torch.Tensor,
+    b: Shape,
+    r_b: torch.Tensor,
+    q_b: torch.Tensor,
+    threads: int = 0,
+    method: Literal["default", "interior_point"] = "default",
+) -> torch.Tensor: ...

@@ -1,0 +1,98 @@
+"""diffpills.torch.proximity: torch.autograd.gradcheck in float64, float32 within its precision,
+shared poses' gradients summed, errors."""
+
+import numpy as np
+import pytest
+import torch
+
+import diffpills
+import diffpills.torch as dtorch
+from shapes_for_tests import random_capsule, random_polygon, random_quaternion
+
+MAKERS = {"capsule": random_capsule, "polygon": random_polygon}
+
+
+def _poses(rng, n, dtype=torch.float64):
+    r = torch.tensor(rng.uniform(-1.5, 1.5, (n, 3)), dtype=dtype, requires_grad=True)
+    q = torch.tensor(np.array([random_quaternion(rng) for _ in range(n)]), dtype=dtype, requires_grad=True)
+    return r, q
+
+
+def _separated(rng, a, b, n):
+    """Random pose pairs whose cores are apart (phi's gradient is zero, and not differentiable at
+    the boundary, where cores touch)."""
+    r_a, q_a = _poses(rng, 4 * n)
+    r_b, q_b = _poses(rng, 4 * n)
+    phi = dtorch.proximity(a, r_a, q_a, b, r_b, q_b)
+    keep = phi.detach() > -(a.radius + b.radius) ** 2 + 1e-3
+    keep = keep.nonzero().squeeze(1)[:n]
+    pick = lambda t: t.detach()[keep].clone().requires_grad_(True)
+    return pick(r_a), pick(q_a), pick(r_b), pick(q_b)
+
+
+@pytest.mark.parametrize("first", ["capsule", "polygon"])
+@pytest.mark.parametrize("second", ["capsule", "polygon"])
+def test_gradcheck_float64(first, second):
+    rng = np.random.default_rng(11)
+    a, _ = MAKERS[first](rng)
+    b, _ = MAKERS[second](rng)
+    inputs = _separated(rng, a, b, 12)
+    assert torch.autograd.gradcheck(
+        lambda *x: dtorch.proximity(a, x[0], x[1], b, x[2], x[3]), inputs, eps=1e-6, atol=1e-6, rtol=1e-5
+    )
+
+
+def test_matches_the_batch_and_float32_is_within_its_precision():
+    rng = np.random.default_rng(12)
+    a, _ = random_polygon(rng)
+    b, _ = random_capsule(rng)
+    r_a, q_a = _poses(rng, 200)
+    r_b, q_b = _poses(rng, 200)
+    phi = dtorch.proximity(a, r_a, q_a, b, r_b, q_b)
+    expected, gradient = diffpills.proximity_batch(
+        a, r_a.detach().numpy(), q_a.detach().numpy(), b, r_b.detach().numpy(), q_b.detach().numpy()
+    )
+    np.testing.assert_array_equal(phi.detach().numpy(), expected)
+    phi.sum().backward()
+    np.testing.assert_array_equal(r_a.grad.numpy(), gradient[:, 0:3])
+    np.testing.assert_array_equal(q_b.grad.numpy(), gradient[:, 10:14])
+
+    single = [t.detach().float().requires_grad_(True) for t in (r_a, q_a, r_b, q_b)]
+    phi32 = dtorch.proximity(a, single[0], single[1], b, single[2], single[3])
+    assert phi32.dtype == torch.float32
+    phi32.sum().backward()
+    scale = 1.0 + np.abs(expected).max()
+    np.testing.assert_allclose(phi32.detach().numpy(), expected, atol=1e-5 * scale)
+    np.testing.assert_allclose(single[0].grad.numpy(), gradient[:, 0:3], atol=1e-4 * (1 + np.abs(gradient).max()))
+
+
+def test_a_shared_pose_gets_the_summed_gradient():
+    rng = np.random.default_rng(13)
+    a, _ = random_capsule(rng)
+    b, _ = random_polygon(rng)
+    r_a, q_a = _poses(rng, 30)
+    r_b = torch.tensor([0.2, -0.1, 0.3], dtype=torch.float64, requires_grad=True)
+    q_b = torch.tensor([1.0, 0.2, 0.0, 0.1], dtype=torch.float64, requires_grad=True)
+    phi = dtorch.proximity(a, r_a, q_a, b, r_b, q_b)
+    phi.sum().backward()
+    _, gradient = diffpills.proximity_batch(
+        a, r_a.detach().numpy(), q_a.detach().numpy(), b, r_b.detach().numpy(), q_b.detach().numpy()
+    )
+    np.testing.assert_allclose(r_b.grad.numpy(), gradient[:, 7:10].sum(axis=0), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(q_b.grad.numpy(), gradient[:, 10:14].sum(axis=0), rtol=1e-12, atol=1e-12)
+
+
+def test_bad_input():
+    capsule = diffpills.Capsule(1.0, 0.1)
+    r = torch.zeros(4, 3, dtype=torch.float64)
+    q = torch.tensor([[1.0, 0.0, 0.0, 0.0]] * 4, dtype=torch.float64)
+    with pytest.raises(ValueError, match="q_a"):
+        dtorch.proximity(capsule, r, torch.zeros(4, 3, dtype=torch.float64), capsule, r, q)
+    with pytest.raises(ValueError, match="r_b"):
+        dtorch.proximity(capsule, r, q, capsule, r.float(), q)
+    with pytest.raises(ValueError, match="q_b"):
+        dtorch.proximity(capsule, r, q, capsule, r, q[:3])
+    with pytest.raises(ValueError, match=r"q_a\[0\]"):
+        dtorch.proximity(capsule, r, torch.zeros(4, 4, dtype=torch.float64), capsule, r, q)
+    with pytest.raises(TypeError, match="r_a"):
+        dtorch.proximity(capsule, np.zeros((4, 3)), q, capsule, r, q)
