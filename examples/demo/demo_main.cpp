@@ -14,6 +14,7 @@
 
 #include "car_bus/car_bus.hpp"
 #include "car_bus/car_bus_ipopt.hpp"
+#include "demo_json.hpp"
 #include "demo_scene.hpp"
 #include "json_io.hpp"
 #include "quadrotor_window_outputs.hpp"
@@ -23,10 +24,8 @@ namespace {
 
 using namespace diffpills;
 using json = nlohmann::ordered_json;
-
-json list(const Eigen::VectorXd& v) {
-  return json(std::vector<double>(v.data(), v.data() + v.size()));
-}
+using examples::altro_summary;
+using examples::json_list;
 
 struct CarBusRun {
   trajopt::AltroResult result;
@@ -90,19 +89,11 @@ void write_car_bus_json(const examples::CarBusProblem& problem, const CarBusRun&
                     {"wheelbase", s.car_model.wheelbase},
                     {"car", {{"length", s.car.length()}, {"radius", s.car.radius()}}},
                     {"bus", bus},
-                    {"x0", list(s.x0)},
-                    {"goal", list(s.goal)},
-                    {"control_limit", list(s.control_limit)},
+                    {"x0", json_list(s.x0)},
+                    {"goal", json_list(s.goal)},
+                    {"control_limit", json_list(s.control_limit)},
                     {"initial_guess_min_phi", run.guess_min_phi},
-                    {"solver",
-                     {{"name", "altro"},
-                      {"status", trajopt::to_string(run.result.status)},
-                      {"iterations", run.result.iterations},
-                      {"outer_iterations", run.result.outer_iterations},
-                      {"polish_iterations", run.result.polish_iterations},
-                      {"max_violation", run.result.max_violation},
-                      {"cost", run.result.cost},
-                      {"solve_ms", run.solve_ms}}},
+                    {"solver", altro_summary(run.result, run.solve_ms)},
                     {"ipopt",
                      {{"status", run.ipopt.status},
                       {"iterations", run.ipopt.iterations},

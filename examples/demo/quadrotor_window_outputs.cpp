@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <nlohmann/json.hpp>
 
+#include "demo_json.hpp"
 #include "json_io.hpp"
 #include "svg.hpp"
 
@@ -15,10 +16,6 @@ namespace diffpills::examples {
 namespace {
 
 using json = nlohmann::ordered_json;
-
-json list(const Eigen::VectorXd& v) {
-  return json(std::vector<double>(v.data(), v.data() + v.size()));
-}
 
 // The angle between body z and world z: cos = R(q)_zz = 1 - 2 (qx^2 + qy^2).
 double tilt_deg(const Eigen::VectorXd& x) {
@@ -89,34 +86,26 @@ void write_quadrotor_window_json(const QuadrotorWindowProblem& problem,
                     {"N", s.knots},
                     {"quadrotor",
                      {{"mass", s.model.mass},
-                      {"inertia", list(s.model.inertia)},
+                      {"inertia", json_list(s.model.inertia)},
                       {"arm", s.model.arm},
                       {"torque_per_thrust", s.model.torque_per_thrust},
                       {"gravity", s.model.gravity},
                       {"thrust_max", s.thrust_max},
                       {"body", body}}},
                     {"window",
-                     {{"centre", list(s.window_centre)},
+                     {{"centre", json_list(s.window_centre)},
                       {"width", s.window_width},
                       {"height", s.window_height},
                       {"tilt", s.window_tilt}}},
                     {"wall", wall},
                     {"poles", poles},
-                    {"x0", list(s.x0)},
-                    {"goal", list(s.goal)},
+                    {"x0", json_list(s.x0)},
+                    {"goal", json_list(s.goal)},
                     {"initial_guess", "hover thrust at every step"},
                     {"level_straight_line_min_phi", run.level_straight_line_min_phi},
                     {"min_phi", run.min_phi},
                     {"largest_tilt_deg", run.largest_tilt_deg},
-                    {"solver",
-                     {{"name", "altro"},
-                      {"status", trajopt::to_string(run.result.status)},
-                      {"iterations", run.result.iterations},
-                      {"outer_iterations", run.result.outer_iterations},
-                      {"polish_iterations", run.result.polish_iterations},
-                      {"max_violation", run.result.max_violation},
-                      {"cost", run.result.cost},
-                      {"solve_ms", run.solve_ms}}}};
+                    {"solver", altro_summary(run.result, run.solve_ms)}};
   std::ofstream(path) << out.dump(2) << "\n";
 }
 

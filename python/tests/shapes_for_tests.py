@@ -65,6 +65,11 @@ def random_quaternion(rng):
     return q / np.linalg.norm(q) * rng.uniform(0.5, 2.0)
 
 
+def random_poses(rng, n, spread=1.5):
+    """n positions (n, 3) and quaternions (n, 4) as NumPy arrays."""
+    return rng.uniform(-spread, spread, (n, 3)), np.array([random_quaternion(rng) for _ in range(n)])
+
+
 def random_pose(rng, spread=1.5):
     return diffpills.Pose(rng.uniform(-spread, spread, 3), random_quaternion(rng))
 

@@ -8,13 +8,9 @@ import numpy as np
 import pytest
 
 import diffpills
-from shapes_for_tests import random_capsule, random_polygon, random_quaternion
+from shapes_for_tests import random_capsule, random_polygon, random_poses
 
 MAKERS = {"capsule": random_capsule, "polygon": random_polygon}
-
-
-def _poses(rng, n):
-    return rng.uniform(-1.5, 1.5, (n, 3)), np.array([random_quaternion(rng) for _ in range(n)])
 
 
 @pytest.mark.parametrize("first", ["capsule", "polygon"])
@@ -24,8 +20,8 @@ def test_batch_equals_single_calls(first, second, threads):
     rng = np.random.default_rng(7)
     a, _ = MAKERS[first](rng)
     b, _ = MAKERS[second](rng)
-    r_a, q_a = _poses(rng, 700)
-    r_b, q_b = _poses(rng, 700)
+    r_a, q_a = random_poses(rng, 700)
+    r_b, q_b = random_poses(rng, 700)
     phi, gradient = diffpills.proximity_batch(a, r_a, q_a, b, r_b, q_b, threads=threads)
     assert phi.shape == (700,) and gradient.shape == (700, 14)
     for i in range(0, 700, 7):
@@ -38,7 +34,7 @@ def test_single_pose_broadcasts_and_float32_lists_are_accepted():
     rng = np.random.default_rng(8)
     a, _ = random_polygon(rng)
     b, _ = random_capsule(rng)
-    r_a, q_a = _poses(rng, 50)
+    r_a, q_a = random_poses(rng, 50)
     r_b, q_b = [0.1, 0.2, 0.3], [1.0, 0.0, 0.0, 0.0]
     phi, gradient = diffpills.proximity_batch(a, r_a.astype(np.float32), q_a, b, r_b, q_b)
     for i in range(50):
@@ -53,7 +49,7 @@ def test_batch_releases_the_gil():
     # While a long batch runs in a thread, the main thread keeps executing Python.
     capsule = diffpills.Capsule(1.0, 0.1)
     rng = np.random.default_rng(9)
-    r, q = _poses(rng, 400_000)
+    r, q = random_poses(rng, 400_000)
     done = threading.Event()
     worker = threading.Thread(
         target=lambda: (diffpills.proximity_batch(capsule, r, q, capsule, r[::-1].copy(), q, threads=1), done.set())
@@ -91,8 +87,8 @@ def test_caller_owned_outputs_are_written_in_place():
     rng = np.random.default_rng(14)
     a, _ = random_capsule(rng)
     b, _ = random_polygon(rng)
-    r_a, q_a = _poses(rng, 100)
-    r_b, q_b = _poses(rng, 100)
+    r_a, q_a = random_poses(rng, 100)
+    r_b, q_b = random_poses(rng, 100)
     phi, gradient = np.empty(100), np.empty((100, 14))
     returned = diffpills.proximity_batch(a, r_a, q_a, b, r_b, q_b, out=(phi, gradient))
     assert returned[0] is phi and returned[1] is gradient

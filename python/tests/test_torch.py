@@ -7,15 +7,14 @@ import torch
 
 import diffpills
 import diffpills.torch as dtorch
-from shapes_for_tests import random_capsule, random_polygon, random_quaternion
+from shapes_for_tests import random_capsule, random_polygon, random_poses
 
 MAKERS = {"capsule": random_capsule, "polygon": random_polygon}
 
 
-def _poses(rng, n, dtype=torch.float64):
-    r = torch.tensor(rng.uniform(-1.5, 1.5, (n, 3)), dtype=dtype, requires_grad=True)
-    q = torch.tensor(np.array([random_quaternion(rng) for _ in range(n)]), dtype=dtype, requires_grad=True)
-    return r, q
+def _poses(rng, n):
+    r, q = random_poses(rng, n)
+    return torch.tensor(r, requires_grad=True), torch.tensor(q, requires_grad=True)
 
 
 def _separated(rng, a, b, n):

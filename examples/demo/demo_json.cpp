@@ -1,0 +1,22 @@
+#include "demo_json.hpp"
+
+#include <vector>
+
+namespace diffpills::examples {
+
+nlohmann::ordered_json json_list(const Eigen::VectorXd& v) {
+  return nlohmann::ordered_json(std::vector<double>(v.data(), v.data() + v.size()));
+}
+
+nlohmann::ordered_json altro_summary(const trajopt::AltroResult& result, double solve_ms) {
+  return {{"name", "altro"},
+          {"status", trajopt::to_string(result.status)},
+          {"iterations", result.iterations},
+          {"outer_iterations", result.outer_iterations},
+          {"polish_iterations", result.polish_iterations},
+          {"max_violation", result.max_violation},
+          {"cost", result.cost},
+          {"solve_ms", solve_ms}};
+}
+
+}  // namespace diffpills::examples

@@ -1,0 +1,18 @@
+// JSON pieces the demo's problem files share.
+#pragma once
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "diffpills/trajopt/altro.hpp"
+
+namespace diffpills::examples {
+
+// A vector as a JSON list of numbers.
+nlohmann::ordered_json json_list(const Eigen::VectorXd& v);
+
+// The "solver" block: name, status, iterations, outer and polish iterations, max_violation, cost
+// and solve_ms.
+nlohmann::ordered_json altro_summary(const trajopt::AltroResult& result, double solve_ms);
+
+}  // namespace diffpills::examples
