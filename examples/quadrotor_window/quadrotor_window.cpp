@@ -8,6 +8,13 @@ namespace diffpills::examples {
 
 namespace {
 
+// The rectangle |x| <= half_x, |y| <= half_y in the body xy-plane, padded by radius.
+PaddedPolygon padded_rectangle(double half_x, double half_y, double radius) {
+  Eigen::MatrixX2d C(4, 2);
+  C << 1.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, -1.0;
+  return PaddedPolygon(C, Eigen::Vector4d(half_x, half_x, half_y, half_y), radius);
+}
+
 // A rectangle [s0, s1] x [t0, t1] of the wall, padded by radius: s runs across the window, t
 // along it, and the wall is the plane x = centre.x turned by tilt about the world x axis, so that
 // before the tilt s is world y and t world z. The panel's body frame is the world's turned by +90
@@ -15,16 +22,11 @@ namespace {
 // rectangle so that the polygon contains its origin.
 PosedPolygon wall_panel(const Eigen::Vector3d& centre, double tilt, double s0, double s1, double t0,
                         double t1, double radius) {
-  Eigen::MatrixX2d C(4, 2);
-  C << 1.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, -1.0;
-  const double half_t = 0.5 * (t1 - t0), half_s = 0.5 * (s1 - s0);
-  Eigen::VectorXd d(4);
-  d << half_t, half_t, half_s, half_s;
   const Eigen::Quaterniond rotation =
       Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX())) *
       Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * M_PI, Eigen::Vector3d::UnitY()));
   const Eigen::Vector3d offset = rotation * Eigen::Vector3d(-0.5 * (t0 + t1), 0.5 * (s0 + s1), 0.0);
-  return {PaddedPolygon(C, d, radius),
+  return {padded_rectangle(0.5 * (t1 - t0), 0.5 * (s1 - s0), radius),
           Pose(centre + offset,
                Eigen::Vector4d(rotation.w(), rotation.x(), rotation.y(), rotation.z()))};
 }
@@ -43,13 +45,6 @@ Eigen::VectorXd hover_state(double x, double y, double z) {
   return state;
 }
 
-// A square of the given half-side in the body xy-plane, padded by radius.
-PaddedPolygon padded_square(double half_side, double radius) {
-  Eigen::MatrixX2d C(4, 2);
-  C << 1.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, -1.0;
-  return PaddedPolygon(C, Eigen::Vector4d::Constant(half_side), radius);
-}
-
 }  // namespace
 
 // The wall is a 3 m square of four panels 0.3 m thick (radius 0.15) around the window, whose
@@ -66,7 +61,7 @@ PaddedPolygon padded_square(double half_side, double radius) {
 //   iterates got stuck at phi = -(R1 + R2)^2 for some horizons. The padding here (0.25 m in sum)
 //   keeps every horizon from 31 to 81 knots solvable (measured).
 QuadrotorWindowScenario::QuadrotorWindowScenario()
-    : body(padded_square(body_half_side, body_radius)),
+    : body(padded_rectangle(body_half_side, body_half_side, body_radius)),
       x0(hover_state(0.0, 0.0, 1.5)),
       goal(hover_state(6.0, 0.0, 1.5)) {
   const double radius = wall_radius, half_wall = wall_half_size;
@@ -96,11 +91,9 @@ double quadrotor_min_phi(const QuadrotorWindowScenario& scenario, const Eigen::V
 QuadrotorWindowProblem::QuadrotorWindowProblem(QuadrotorWindowScenario scenario)
     : scenario_(std::move(scenario)) {
   hover_ = Eigen::Vector4d::Constant(scenario_.model.hover_thrust());
-  Eigen::VectorXd q(13), qf(13);
-  // position, attitude, velocity, angular velocity
-  q << 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01;
-  qf << 10, 10, 10, 10, 10, 10, 10, 10, 10, 10, 1, 1, 1;
-  Q_ = q.asDiagonal();
+  Q_ = 0.01 * Eigen::MatrixXd::Identity(13, 13);
+  Eigen::VectorXd qf = Eigen::VectorXd::Constant(13, 10.0);
+  qf.tail<3>().setConstant(1.0);  // angular velocity weighs less at the end
   Qf_ = qf.asDiagonal();
   R_ = 0.1 * Eigen::MatrixXd::Identity(4, 4);
 }
