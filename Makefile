@@ -2,9 +2,11 @@
 # need first (scripts/install-deps.sh, only what is missing).
 BUILD ?= build
 SANITIZE_BUILD ?= build-sanitize
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 300
 JOBS ?= 2
 
-.PHONY: all deps build test test-sanitize demo bench format clean
+.PHONY: all deps build test test-sanitize fuzz fuzz-build demo bench format clean
 
 all: build
 
@@ -31,6 +33,17 @@ test-sanitize: deps
 	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(SANITIZE_BUILD) --output-on-failure -LE no_sanitize
 
+# The libFuzzer targets (fuzz/), built with clang-14 under ASan + UBSan, each run for FUZZ_SECONDS
+# from the committed seed corpus (fuzz/corpus/); new inputs collect in $(FUZZ_BUILD)/corpus and a
+# failing input is saved in $(FUZZ_BUILD)/artifacts.
+fuzz-build: deps
+	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
+	  -DDIFFPILLS_FUZZ=ON -DDIFFPILLS_BUILD_TESTS=OFF -DDIFFPILLS_BUILD_BENCHMARKS=OFF
+	cmake --build $(FUZZ_BUILD) -j$(JOBS) --target fuzz_proximity fuzz_query
+
+fuzz: fuzz-build
+	bash scripts/run-fuzzers.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
+
 # The motion-planning demo (car-bus and quadrotor-window problems: out/*.csv, *.json, *.svg), then
 # the Python example that untangles a heap of shapes (out/untangle_{before,after}.png).
 demo: build
@@ -44,4 +57,4 @@ format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')
 
 clean:
-	rm -rf $(BUILD) $(SANITIZE_BUILD)
+	rm -rf $(BUILD) $(SANITIZE_BUILD) $(FUZZ_BUILD)

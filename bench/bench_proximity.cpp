@@ -153,6 +153,42 @@ void HexagonHexagon_FclDistance(benchmark::State& s) {
   run_fcl(s, *fcl_hexagon(kHexagonA), false, *fcl_hexagon(kHexagonB), false);
 }
 
+// Growth with the vertex count (issue 9): regular k-gons of circumradius 0.6 and 0.43 (radii 0.1,
+// 0.05) at the scene's poses, for k from 8 to 10^5. Up to 32 x 32 vertex pairs every edge pair is
+// enumerated; beyond, the windows of polygon_windows.hpp make a pair about linear in k.
+PaddedPolygon regular_polygon(int count, double circumradius, double radius) {
+  Eigen::MatrixX2d C(count, 2);
+  for (int i = 0; i < count; ++i) {
+    C.row(i) << std::cos(2 * M_PI * i / count), std::sin(2 * M_PI * i / count);
+  }
+  return PaddedPolygon(C, Eigen::VectorXd::Constant(count, circumradius * std::cos(M_PI / count)),
+                       radius);
+}
+
+void PolygonPolygon_Vertices(benchmark::State& state) {
+  const auto count = static_cast<int>(state.range(0));
+  run_proximity(state, regular_polygon(count, 0.6, 0.1), regular_polygon(count, 0.43, 0.05),
+                Method::kDefault);
+  state.SetComplexityN(count);
+}
+void CapsulePolygon_Vertices(benchmark::State& state) {
+  const auto count = static_cast<int>(state.range(0));
+  run_proximity(state, kCapsuleA, regular_polygon(count, 0.6, 0.1), Method::kDefault);
+  state.SetComplexityN(count);
+}
+BENCHMARK(PolygonPolygon_Vertices)
+    ->RangeMultiplier(4)
+    ->Range(8, 32768)
+    ->Arg(100000)
+    ->Complexity()
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(CapsulePolygon_Vertices)
+    ->RangeMultiplier(4)
+    ->Range(8, 32768)
+    ->Arg(100000)
+    ->Complexity()
+    ->Unit(benchmark::kMicrosecond);
+
 // proximity_batch over 10^5 pose pairs with 1 and 2 threads (wall-clock time).
 constexpr Eigen::Index kBatch = 100000;
 

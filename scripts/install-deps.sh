@@ -16,6 +16,8 @@ packages=(
   librsvg2-bin           # rsvg-convert: lets a person look at the demo's SVG figures as PNG
   python3-dev pybind11-dev  # the Python bindings
   python3-numpy python3-pytest python3-torch python3-matplotlib  # their tests and example
+  python3-mpmath         # 50-digit references in the Python tests
+  clang-14 libfuzzer-14-dev  # the fuzz targets (make fuzz)
   python3-venv python3-pip python3-setuptools  # the tested `pip install --no-build-isolation .`
 )
 

@@ -1,5 +1,32 @@
+// The polygon's reduction: from the rows C y <= d as given to the non-redundant rows, their
+// vertices and the polygon's extent.
+//
+// Each nonzero row is normalized to n_i . y <= b_i with |n_i| = 1 and b_i = d_i / |C_i| > 0.
+// Because every b_i > 0, the origin lies strictly inside every half-plane, so the polygon is
+// star-shaped about it: walking the rows by the angle of their normal, each row either bounds the
+// polygon (it has an edge) or is cut away by its neighbours. The walk is a Graham scan around the
+// origin; it starts at the row nearest the origin, which always has an edge (the point b n of
+// that row satisfies every other row: n_j . b n <= b <= b_j).
+//
+// The redundancy test. For rows a, b, c in angular order with 0 < angle(a, c) < pi, the lines of a
+// and c meet at the vertex (Cramer's rule)
+//   v_ac = (b_a [n_c,y, -n_c,x] + b_c [-n_a,y, n_a,x]) / k,   k = n_a x n_c = sin angle(a, c),
+// and row b cuts that vertex off by n_b . v_ac - b_b = E / k with
+//   E = b_a (n_b x n_c) + b_c (n_a x n_b) - b_b (n_a x n_c).
+// E is linear in the offsets: no product of two lengths is ever formed, so the test means the same
+// for offsets of 1e-95 and of 1e100 (a dual formulation, through the points n_i / b_i, squares
+// 1 / b and underflows or overflows at either end). Row b is kept when it cuts more than 1e-12 of
+// the polygon's size off: E > 1e-12 k max_i b_i. That drops exact and rounded duplicates (a row
+// given twice at different scales), rows through an existing vertex, and loose rows, and keeps the
+// rows of a 10^5-gon (whose neighbours cut ~2e-9 of its size). If angle(a, c) >= pi (k <= 0), b is
+// needed to close the polygon and always kept.
+//
+// Bounded <=> consecutive kept normals turn by less than pi. A turn within 1e-12 of pi (or of 0)
+// puts a vertex near infinity; vertices more than 1e12 times the largest offset from the origin
+// are reported as unbounded too, since their position is then fixed only to ~1e-4.
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -9,53 +36,35 @@
 namespace diffpills {
 namespace {
 
-struct DualPoint {
-  Eigen::Vector2d point;  // unit normal / offset
-  int row;                // index into the normalized rows
+struct UnitRow {
+  Eigen::Vector2d normal;
+  double offset = 0.0;
+  double angle = 0.0;
 };
 
-// z-component of (b - a) x (c - a): > 0 when a, b, c turn counterclockwise.
-double turn(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
-  const Eigen::Vector2d u = b - a;
-  const Eigen::Vector2d v = c - a;
-  return u.x() * v.y() - u.y() * v.x();
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
 }
 
-// Andrew's monotone chain: the strictly convex hull, counterclockwise. A middle point b is dropped
-// when it lies within 1e-12 * size of the chord from a to c (turn(a, b, c) = |c - a| times that
-// distance): a dual point on or near a hull edge is a row through an existing vertex, and
-// duplicates that differ by rounding (a row given twice at different scales) would otherwise
-// survive as a sliver edge whose vertex lies near infinity.
-std::vector<DualPoint> convex_hull(std::vector<DualPoint> points) {
-  double size = 0.0;
-  for (const DualPoint& p : points) size = std::max(size, p.point.norm());
-  const auto keeps_convexity = [size](const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                                      const Eigen::Vector2d& c) {
-    return turn(a, b, c) > 1e-12 * size * (c - a).norm();
-  };
-  std::sort(points.begin(), points.end(), [](const DualPoint& a, const DualPoint& b) {
-    return a.point.x() < b.point.x() || (a.point.x() == b.point.x() && a.point.y() < b.point.y());
-  });
-  if (points.size() < 3) {
-    return points;
-  }
-  std::vector<DualPoint> hull(2 * points.size());
-  std::size_t k = 0;
-  for (const DualPoint& p : points) {  // lower hull
-    while (k >= 2 && !keeps_convexity(hull[k - 2].point, hull[k - 1].point, p.point)) {
-      --k;
-    }
-    hull[k++] = p;
-  }
-  const std::size_t lower_size = k + 1;
-  for (auto it = points.rbegin() + 1; it != points.rend(); ++it) {  // upper hull
-    while (k >= lower_size && !keeps_convexity(hull[k - 2].point, hull[k - 1].point, it->point)) {
-      --k;
-    }
-    hull[k++] = *it;
-  }
-  hull.resize(k - 1);  // the last point repeats the first
-  return hull;
+// Row b's cut E (see above) of the vertex of rows a and c, times 1 / (k max_b).
+bool cuts_vertex(const UnitRow& a, const UnitRow& b, const UnitRow& c, double largest_offset) {
+  const double k = cross(a.normal, c.normal);
+  if (k <= 0.0) return true;  // a and c alone leave the polygon open: b closes it
+  const double cut =
+      a.offset * cross(b.normal, c.normal) + c.offset * cross(a.normal, b.normal) - b.offset * k;
+  return cut > 1e-12 * k * largest_offset;
+}
+
+// The row C y <= d as n . y <= b with |n| = 1; false for a row that constrains nothing (C = 0, or
+// an offset beyond the largest double, a half-plane that holds every representable point).
+bool normalize_row(double c0, double c1, double d, UnitRow& row) {
+  const double largest = std::max(std::abs(c0), std::abs(c1));
+  if (largest == 0.0) return false;
+  const double norm = std::hypot(c0, c1);  // no overflow or underflow, unlike sqrt(c0^2 + c1^2)
+  row.normal = Eigen::Vector2d(c0 / norm, c1 / norm);
+  row.offset = d / norm;
+  row.angle = std::atan2(row.normal.y(), row.normal.x());
+  return std::isfinite(row.offset);
 }
 
 }  // namespace
@@ -71,10 +80,8 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
     detail::fail("polygon.d", "must have one entry per row of C (C has " + std::to_string(m) +
                                   " rows, d has " + std::to_string(d.size()) + " entries)");
   }
-  std::vector<DualPoint> dual;
-  dual.reserve(static_cast<std::size_t>(m));
-  std::vector<Eigen::Vector2d> unit_normals(static_cast<std::size_t>(m));
-  std::vector<double> unit_offsets(static_cast<std::size_t>(m));
+  std::vector<UnitRow> rows;
+  rows.reserve(static_cast<std::size_t>(m));
   for (Eigen::Index i = 0; i < m; ++i) {
     const auto row = [i] { return "[" + std::to_string(i) + "]"; };
     detail::require_finite(C(i, 0), [&] { return "polygon.C" + row() + "[0]"; });
@@ -83,57 +90,65 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
     if (!(d(i) > 0.0)) {
       detail::fail("polygon.d" + row(),
                    "must be > 0 so that the body origin lies strictly inside the polygon (got " +
-                       std::to_string(d(i)) + ")");
+                       detail::format_number(d(i)) + ")");
     }
-    const double norm = C.row(i).norm();
-    if (norm == 0.0) {
-      continue;  // 0 <= d(i) holds everywhere: the row constrains nothing
-    }
-    const auto index = static_cast<std::size_t>(i);
-    unit_normals[index] = C.row(i).transpose() / norm;
-    unit_offsets[index] = d(i) / norm;
-    dual.push_back({unit_normals[index] / unit_offsets[index], static_cast<int>(i)});
+    UnitRow unit;
+    if (normalize_row(C(i, 0), C(i, 1), d(i), unit)) rows.push_back(unit);
   }
-
-  const std::vector<DualPoint> hull = convex_hull(dual);
-  // Bounded <=> the origin is strictly inside the dual hull. The margin test is relative to the
-  // hull's size so that it means the same at every scale: an origin within 1e-12 of the hull's
-  // diameter from an edge is a polygon with a vertex near infinity, reported as unbounded.
-  double hull_size = 0.0;
-  for (const DualPoint& p : hull) {
-    hull_size = std::max(hull_size, p.point.norm());
-  }
-  bool bounded = hull.size() >= 3;
-  for (std::size_t i = 0; bounded && i < hull.size(); ++i) {
-    const Eigen::Vector2d& a = hull[i].point;
-    const Eigen::Vector2d& b = hull[(i + 1) % hull.size()].point;
-    bounded = turn(a, b, Eigen::Vector2d::Zero()) > 1e-12 * (b - a).norm() * hull_size;
-  }
-  if (!bounded) {
+  const auto unbounded = [] {
     detail::fail("polygon.C", "the rows C y <= d do not bound a polygon (it is unbounded)");
-  }
+  };
+  if (rows.size() < 3) unbounded();
 
-  const auto k = static_cast<Eigen::Index>(hull.size());
+  // By angle; of rows with the same normal only the tightest can bind.
+  std::sort(rows.begin(), rows.end(), [](const UnitRow& a, const UnitRow& b) {
+    return a.angle < b.angle || (a.angle == b.angle && a.offset < b.offset);
+  });
+  rows.erase(std::unique(rows.begin(), rows.end(),
+                         [](const UnitRow& a, const UnitRow& b) { return a.angle == b.angle; }),
+             rows.end());
+  double largest_offset = 0.0;
+  std::size_t nearest = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    largest_offset = std::max(largest_offset, rows[i].offset);
+    if (rows[i].offset < rows[nearest].offset) nearest = i;
+  }
+  std::rotate(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(nearest), rows.end());
+
+  std::vector<UnitRow> kept;
+  kept.reserve(rows.size());
+  for (std::size_t i = 0; i <= rows.size(); ++i) {
+    const UnitRow& next = rows[i % rows.size()];  // the walk closes on the first row again
+    while (kept.size() >= 2 &&
+           !cuts_vertex(kept[kept.size() - 2], kept.back(), next, largest_offset)) {
+      kept.pop_back();
+    }
+    if (i < rows.size()) kept.push_back(next);
+  }
+  const auto k = static_cast<Eigen::Index>(kept.size());
+  if (k < 3) unbounded();
+
   normals_.resize(k, 2);
   offsets_.resize(k);
   vertices_.resize(k, 2);
   for (Eigen::Index i = 0; i < k; ++i) {
-    const auto row = static_cast<std::size_t>(hull[static_cast<std::size_t>(i)].row);
-    normals_.row(i) = unit_normals[row].transpose();
-    offsets_(i) = unit_offsets[row];
+    normals_.row(i) = kept[static_cast<std::size_t>(i)].normal.transpose();
+    offsets_(i) = kept[static_cast<std::size_t>(i)].offset;
   }
-  // Vertex i solves n_i . y = b_i and n_j . y = b_j (j = i + 1) by Cramer's rule; the determinant
-  // n_i x n_j is positive because consecutive hull normals turn counterclockwise by less than pi.
+  // Vertex i joins edges i and i + 1 (v_ac above with a = i, c = i + 1).
   for (Eigen::Index i = 0; i < k; ++i) {
-    const Eigen::Index j = (i + 1) % k;
-    const Eigen::Vector2d ni = normals_.row(i).transpose();
-    const Eigen::Vector2d nj = normals_.row(j).transpose();
-    const double det = ni.x() * nj.y() - ni.y() * nj.x();
-    vertices_(i, 0) = (offsets_(i) * nj.y() - offsets_(j) * ni.y()) / det;
-    vertices_(i, 1) = (ni.x() * offsets_(j) - nj.x() * offsets_(i)) / det;
-    extent_ = std::max(extent_, vertices_.row(i).norm());
+    const UnitRow& a = kept[static_cast<std::size_t>(i)];
+    const UnitRow& c = kept[static_cast<std::size_t>((i + 1) % k)];
+    const double turn = cross(a.normal, c.normal);
+    if (!(turn > 1e-12)) unbounded();
+    const Eigen::Vector2d vertex = (a.offset * Eigen::Vector2d(c.normal.y(), -c.normal.x()) +
+                                    c.offset * Eigen::Vector2d(-a.normal.y(), a.normal.x())) /
+                                   turn;
+    vertices_.row(i) = vertex.transpose();
+    extent_ = std::max(extent_, vertex.norm());
   }
-  if (!(extent_ <= kMaxMagnitude)) {  // nearly parallel rows can put a vertex near infinity
+  if (!(extent_ <= 1e12 * largest_offset)) unbounded();
+  if (!(extent_ <= kMaxMagnitude)) {
     detail::fail("polygon.C", "a vertex lies farther than 1e100 from the origin");
   }
 }

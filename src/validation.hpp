@@ -24,6 +24,9 @@ void require_nonnegative(double value, const FieldName& field);
 [[noreturn]] void fail_finite(double value, const std::string& field);
 [[noreturn]] void fail_negative(double value, const std::string& field);
 
+// The shortest decimal text that reads back as `value` ("-1e-10", "0.1", "nan").
+std::string format_number(double value);
+
 // "field: problem (got value)".
 [[noreturn]] void fail(const std::string& field, const std::string& problem);
 

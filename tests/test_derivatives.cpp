@@ -8,8 +8,8 @@
 #include <iostream>
 
 #include "diffpills/diffpills.hpp"
-#include "proximity/core.hpp"
 #include "proximity/pair_problem.hpp"
+#include "proximity/parametric_core.hpp"
 #include "support/random_shapes.hpp"
 
 namespace diffpills::testing {
@@ -145,14 +145,22 @@ TEST(Derivatives, EnvelopeGradientEqualsOptNetRoute) {
     const Proximity envelope = proximity(a.shape, pose_a, b.shape, pose_b);
     if (envelope.cores_intersect) continue;
 
+    // The QP in the inputs' own units (a frame of scale 1 at the world origin).
     const auto core_of = [](const Shape& shape) {
-      return std::visit([](const auto& s) { return detail::make_core(s); }, shape);
+      if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+        return detail::make_parametric_capsule(capsule->length());
+      }
+      return detail::make_parametric_polygon(
+          detail::PolygonView(std::get<PaddedPolygon>(shape), 1.0));
     };
-    const detail::Core core_a = core_of(a.shape);
-    const detail::Core core_b = core_of(b.shape);
+    const detail::ParametricCore core_a = core_of(a.shape);
+    const detail::ParametricCore core_b = core_of(b.shape);
+    const auto posed = [](const Eigen::Vector3d& r, const Eigen::Vector4d& q) {
+      return detail::PosedCore{r, detail::UnitQuaternion(q), 0.0, 0.0};
+    };
     const auto problem_at = [&](const Vector14& x) {
-      return detail::make_pair_problem(core_a, Pose(x.segment<3>(0), x.segment<4>(3)), core_b,
-                                       Pose(x.segment<3>(7), x.segment<4>(10)));
+      return detail::make_pair_problem(core_a, posed(x.segment<3>(0), x.segment<4>(3)), core_b,
+                                       posed(x.segment<3>(7), x.segment<4>(10)));
     };
     const Vector14 x0 = pack(pose_a, pose_b);
     const detail::PairProblem problem = problem_at(x0);

@@ -37,6 +37,12 @@
 //     deterministic choice: the unit vector from r1 to r2, or, if the origins coincide too, shape
 //     1's body z axis Q(q1) [0, 0, 1]. Surface points and Jacobians follow that rule.
 //   - Non-unit quaternions are normalized; derivatives include the normalization.
+//   - Magnitudes. Every accepted input (lengths, radii, positions and offsets from 0 up to
+//     kMaxMagnitude, polygons with offsets d as small as 1e-300) is answered to full relative
+//     accuracy: each pair is solved in a frame whose unit is a power of two near the scene's size,
+//     so scaling every length by 2^k scales phi by exactly 2^(2k), the points by 2^k, the
+//     gradient's position part by 2^k and its quaternion part by 2^(2k), bit for bit. The normal
+//     is unit to rounding at every scale.
 //
 // Errors: shapes and poses validate on construction (std::invalid_argument). If the QP solver
 // fails to converge, which the tests have never seen for valid shapes, the query throws

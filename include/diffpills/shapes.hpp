@@ -12,8 +12,9 @@
 
 namespace diffpills {
 
-// Magnitudes above this are rejected: squared distances of such inputs would overflow and turn a
-// result into inf or NaN. 1e100 squared is 1e200, still comfortably finite.
+// Magnitudes above this are rejected: phi, a squared distance, of such inputs could overflow.
+// 1e100 squared is 1e200, still comfortably finite. Every magnitude from 0 to this bound is
+// answered correctly (each pair is solved in a frame scaled by a power of two, pair_frame.hpp).
 inline constexpr double kMaxMagnitude = 1e100;
 
 // A capsule: the core segment runs along the body x axis from [-L/2, 0, 0] to [L/2, 0, 0] and is
@@ -37,11 +38,13 @@ class Capsule {
 //   - d > 0: the body origin lies strictly inside the polygon;
 //   - the polygon is bounded;
 //   - 0 <= radius <= kMaxMagnitude.
-// Redundant rows (zero rows, rows implied by others, duplicates) are allowed and dropped. The
-// constructor computes the polygon's vertices once, in O(m log m), through the polar dual: with
-// d > 0 the half-plane c_i y <= d_i maps to the point c_i / d_i, the rows that bound the polygon
-// are the vertices of the convex hull of those points, and the polygon is bounded exactly when the
-// origin lies strictly inside that hull.
+// Redundant rows (zero rows, rows implied by others, duplicates, rows that cut less than 1e-12 of
+// the polygon's size off) are allowed and dropped. A polygon whose vertex lies more than 1e12
+// times its largest offset from the origin (two consecutive edges within 1e-12 of parallel) is
+// reported as unbounded. The constructor computes the polygon's vertices once, in O(m log m), by
+// walking the rows in the order of their normals' angles around the origin (which lies inside);
+// the test that drops a row is linear in the offsets, so offsets from 1e-300 to 1e100 are handled
+// alike.
 class PaddedPolygon {
  public:
   PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d, double radius);

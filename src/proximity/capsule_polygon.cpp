@@ -2,69 +2,75 @@
 #include <limits>
 
 #include "fast_paths.hpp"
-#include "polygon_features.hpp"
 #include "segment_segment.hpp"
 
 namespace diffpills::detail {
 
 // In the polygon's body frame the core is {(y, 0) : y in polygon} and the segment is
-// x(s) = p + s u, s in [0, 1]. The closest pair is one of
+// x(s) = p + s L u, s in [0, 1], |u| = 1. The closest pair is one of
 //   - a crossing of the plane z = 0 inside the polygon (distance zero, a single point unless the
 //     segment lies in the plane);
 //   - an end point over the face (distance |z|);
 //   - the segment against an edge (segment_segment.hpp).
-// A segment parallel to the plane, |u_z| <= 1e-12 |u|, whose shadow overlaps the polygon has a
-// whole interval of closest points; its middle is returned. The threshold is on the sine, not its
-// square: the height varies linearly with a tilt, and the middle of the interval is then within
-// 1e-12 |u| of the optimal distance.
-std::array<CoreSolution, 2> solve_capsule_polygon(const Capsule& capsule,
-                                                  const PosedCore& posed_capsule,
-                                                  const PaddedPolygon& polygon,
-                                                  const PosedCore& posed_polygon) {
-  const double length = capsule.length();
+// Where the closest points are not unique the optimal set is an interval, of two kinds:
+//   - the segment parallel to the plane, |u_z| <= 1e-12 (the height varies linearly with a tilt,
+//     so the threshold is on the sine), over the face: its part over the face (also when it lies
+//     in the plane);
+//   - the segment parallel to an edge and beside it: the overlap of the two, which the edge's
+//     segment-segment solution reports (SegmentParameters::overlap). Its distance ties with the
+//     neighbouring edges' at the shared vertex; the overlap wins ties within the tolerance.
+// Both are found with the polygon grown by the tolerance, so that a segment touching the boundary
+// is not decided by rounding.
+std::array<ClosestFeature, 2> solve_capsule_polygon(const PosedCore& capsule,
+                                                    const PolygonView& polygon,
+                                                    const PosedCore& posed_polygon,
+                                                    double tolerance) {
+  const double length = capsule.size;
   const Eigen::Matrix3d& R = posed_polygon.attitude.matrix();
-  const Eigen::Vector3d axis = length * posed_capsule.attitude.matrix().col(0);
-  const Eigen::Vector3d p = R.transpose() * (posed_capsule.r - 0.5 * axis - posed_polygon.r);
+  const Eigen::Vector3d axis = capsule.attitude.matrix().col(0);
+  const Eigen::Vector3d p = R.transpose() * (capsule.r - 0.5 * length * axis - posed_polygon.r);
   const Eigen::Vector3d u = R.transpose() * axis;
+  const Segment segment{p, u, length};
 
-  const double u_norm = u.norm();
-  if (u_norm > 0.0 && std::abs(u.z()) <= 1e-12 * u_norm) {
-    const auto [low, high] = clip_line(polygon, p.head<2>(), u.head<2>());
+  if (length > 0.0 && std::abs(u.z()) <= 1e-12) {
+    const auto [low, high] = clip_line(polygon, p.head<2>(), length * u.head<2>(), tolerance);
     if (low <= high) {
       const double s = 0.5 * (low + high);
-      return {segment_point(length, s), face_point((p + s * u).head<2>())};
+      return {segment_point(length, s), face_point((p + s * length * u).head<2>())};
     }
   }
-  const double z0 = p.z(), z1 = p.z() + u.z();
+  const double z0 = p.z(), z1 = p.z() + length * u.z();
   if ((z0 < 0.0 && z1 > 0.0) || (z0 > 0.0 && z1 < 0.0)) {
     const double s = z0 / (z0 - z1);
-    const Eigen::Vector2d crossing = (p + s * u).head<2>();
-    if (contains(polygon, crossing)) {
+    const Eigen::Vector2d crossing = (p + s * length * u).head<2>();
+    if (contains(polygon, crossing, tolerance)) {
       return {segment_point(length, s), face_point(crossing)};
     }
   }
 
-  double best = std::numeric_limits<double>::infinity();
-  std::array<CoreSolution, 2> sides;
+  struct Candidate {
+    double distance2 = std::numeric_limits<double>::infinity();
+    std::array<ClosestFeature, 2> sides;
+  } best, best_overlap;
   for (const double s : {0.0, 1.0}) {
-    const Eigen::Vector3d end = p + s * u;
-    if (end.z() * end.z() < best && contains(polygon, end.head<2>())) {
-      best = end.z() * end.z();
-      sides = {segment_point(length, s), face_point(end.head<2>())};
+    const Eigen::Vector3d end = p + s * length * u;
+    if (end.z() * end.z() < best.distance2 && contains(polygon, end.head<2>(), 0.0)) {
+      best = {end.z() * end.z(), {segment_point(length, s), face_point(end.head<2>())}};
     }
   }
-  for (Eigen::Index j = 0; j < polygon.vertices().rows(); ++j) {
-    Eigen::Vector3d start = Eigen::Vector3d::Zero(), edge = Eigen::Vector3d::Zero();
-    start.head<2>() = edge_start(polygon, j);
-    edge.head<2>() = edge_end(polygon, j) - start.head<2>();
-    const SegmentParameters closest = closest_segment_parameters(p, u, start, edge);
-    const double distance2 = (p + closest.s * u - start - closest.t * edge).squaredNorm();
-    if (distance2 < best) {
-      best = distance2;
-      sides = {segment_point(length, closest.s), edge_point(polygon, j, closest.t)};
+  for (Eigen::Index j = 0; j < polygon.size(); ++j) {
+    const Segment edge = polygon.edge(j);
+    const SegmentParameters closest = closest_segment_parameters(segment, edge);
+    const double distance2 =
+        (p + (closest.s * length) * u - edge.start - (closest.t * edge.length) * edge.direction)
+            .squaredNorm();
+    Candidate& kept = closest.overlap ? best_overlap : best;
+    if (distance2 < kept.distance2) {
+      kept = {distance2, {segment_point(length, closest.s), edge_point(polygon, j, closest.t)}};
     }
   }
-  return sides;
+  const double reach = std::sqrt(best.distance2) + tolerance;
+  return best_overlap.distance2 <= reach * reach ? best_overlap.sides : best.sides;
 }
 
 }  // namespace diffpills::detail

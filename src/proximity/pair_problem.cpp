@@ -2,8 +2,6 @@
 
 #include <algorithm>
 
-#include "diffpills/rotation.hpp"
-
 namespace diffpills::detail {
 
 Eigen::VectorXd PairProblem::parameters(int i, const Eigen::VectorXd& x) const {
@@ -11,16 +9,16 @@ Eigen::VectorXd PairProblem::parameters(int i, const Eigen::VectorXd& x) const {
 }
 
 Eigen::Vector3d PairProblem::body_point(int i, const Eigen::VectorXd& x) const {
-  const Core& core = *cores[static_cast<std::size_t>(i)];
+  const ParametricCore& core = *cores[static_cast<std::size_t>(i)];
   return core.U.leftCols(core.dim) * parameters(i, x) + core.u0;
 }
 
-PairProblem make_pair_problem(const Core& core1, const Pose& pose1, const Core& core2,
-                              const Pose& pose2) {
+PairProblem make_pair_problem(const ParametricCore& core1, const PosedCore& pose1,
+                              const ParametricCore& core2, const PosedCore& pose2) {
   PairProblem problem;
   problem.cores = {&core1, &core2};
-  const Eigen::Matrix3d rotation1 = rotation_matrix(pose1.q());
-  const Eigen::Matrix3d rotation2 = rotation_matrix(pose2.q());
+  const Eigen::Matrix3d& rotation1 = pose1.attitude.matrix();
+  const Eigen::Matrix3d& rotation2 = pose2.attitude.matrix();
   // Two spheres have no parameters and no size; any positive scale then serves.
   problem.scale = std::max(core1.size, core2.size);
   if (problem.scale == 0.0) {
@@ -32,7 +30,7 @@ PairProblem make_pair_problem(const Core& core1, const Pose& pose1, const Core& 
   problem.F.resize(3, n1 + n2);
   problem.F.leftCols(n1) = inverse_scale * rotation1 * core1.U.leftCols(n1);
   problem.F.rightCols(n2) = -inverse_scale * rotation2 * core2.U.leftCols(n2);
-  problem.g = inverse_scale * (pose1.r() + rotation1 * core1.u0 - pose2.r() - rotation2 * core2.u0);
+  problem.g = inverse_scale * (pose1.r + rotation1 * core1.u0 - pose2.r - rotation2 * core2.u0);
   const Eigen::Index m1 = core1.G.rows();
   const Eigen::Index m2 = core2.G.rows();
   problem.G = Eigen::MatrixXd::Zero(m1 + m2, n1 + n2);

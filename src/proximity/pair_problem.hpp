@@ -15,13 +15,13 @@
 #include <Eigen/Core>
 #include <array>
 
-#include "core.hpp"
-#include "diffpills/shapes.hpp"
+#include "parametric_core.hpp"
+#include "posed_core.hpp"
 
 namespace diffpills::detail {
 
 struct PairProblem {
-  std::array<const Core*, 2> cores{};
+  std::array<const ParametricCore*, 2> cores{};
   double scale = 1.0;  // s
   Eigen::MatrixXd F;   // 3 x n
   Eigen::Vector3d g;
@@ -35,8 +35,8 @@ struct PairProblem {
   Eigen::Vector3d body_point(int i, const Eigen::VectorXd& x) const;
 };
 
-// The cores must outlive the problem.
-PairProblem make_pair_problem(const Core& core1, const Pose& pose1, const Core& core2,
-                              const Pose& pose2);
+// The cores must outlive the problem. The poses are the posed cores' (in the query's frame).
+PairProblem make_pair_problem(const ParametricCore& core1, const PosedCore& pose1,
+                              const ParametricCore& core2, const PosedCore& pose2);
 
 }  // namespace diffpills::detail

@@ -11,30 +11,22 @@ using Matrix3x14 = Eigen::Matrix<double, 3, 14>;
 
 // d p / d[r1 q1 r2 q2] with the body point u held fixed: p = r + Q(q) u, so dp/dr = I and
 // dp/dq = d(Q(q) u)/dq, in the shape's seven columns (column offset 0 or 7).
-Matrix3x14 fixed_point_jacobian(const PosedCore& core, const CoreSolution& solution, int column) {
+Matrix3x14 fixed_point_jacobian(const PosedCore& core, const ClosestFeature& side, int column) {
   Matrix3x14 jacobian = Matrix3x14::Zero();
   jacobian.block<3, 3>(0, column).setIdentity();
-  jacobian.block<3, 4>(0, column + 3) = core.attitude.rotate_jacobian(solution.body_point);
+  jacobian.block<3, 4>(0, column + 3) = core.attitude.rotate_jacobian(side.body_point);
   return jacobian;
-}
-
-// Below this distance the cores count as intersecting. Rounding in p1 - p2 is of order
-// eps * max(|p1|, |p2|, core size), so the threshold is relative to the same quantities.
-double intersection_tolerance(const PosedCore& a, const PosedCore& b, const Eigen::Vector3d& p1,
-                              const Eigen::Vector3d& p2) {
-  return 1e-12 *
-         std::max({a.size, b.size, p1.lpNorm<Eigen::Infinity>(), p2.lpNorm<Eigen::Infinity>()});
 }
 
 enum class NormalRule { kClosestPoints, kOrigins, kBodyAxis };
 
-// The normal's rule (see proximity.hpp): the closest-point direction while the cores are apart;
-// otherwise the direction between the body origins, or shape 1's body z axis if those coincide.
-// Compared squared, to spare square roots on the hot path.
-NormalRule normal_rule(const PosedCore& a, const PosedCore& b, const Eigen::Vector3d& p1,
-                       const Eigen::Vector3d& p2) {
-  const double tolerance = intersection_tolerance(a, b, p1, p2);
-  const double tolerance2 = tolerance * tolerance;
+// The normal's rule (see proximity.hpp): the closest-point direction while the cores are apart by
+// more than the frame's tolerance (1e-12 of the scene's size); otherwise the direction between the
+// body origins, or shape 1's body z axis if those coincide too. Compared squared, to spare square
+// roots on the hot path; in the frame's units no square under- or overflows.
+NormalRule normal_rule(const PairFrame& frame, const PosedCore& a, const PosedCore& b,
+                       const Eigen::Vector3d& p1, const Eigen::Vector3d& p2) {
+  const double tolerance2 = frame.tolerance * frame.tolerance;
   if ((p2 - p1).squaredNorm() > tolerance2) return NormalRule::kClosestPoints;
   if ((b.r - a.r).squaredNorm() > tolerance2) return NormalRule::kOrigins;
   return NormalRule::kBodyAxis;
@@ -47,7 +39,7 @@ Matrix3x14 unit_vector_motion(const Eigen::Vector3d& v, const Matrix3x14& dv) {
   return (dv - n * (n.transpose() * dv)) * inverse_length;
 }
 
-// Implicit function theorem with the active set eliminated (core_solution.hpp). Near the
+// Implicit function theorem with the active set eliminated (posed_core.hpp). Near the
 // solution p_i = r_i + Q_i (u_i + D_i xi_i), and the free coordinates xi = (xi1, xi2) minimize
 // |e|^2, e = p1 - p2, without constraints. With M = [Q1 D1, -Q2 D2] stationarity is M'e = 0;
 // differentiating in a pose coordinate at the solution (xi = 0),
@@ -60,8 +52,8 @@ Matrix3x14 unit_vector_motion(const Eigen::Vector3d& v, const Matrix3x14& dv) {
 // parallel tests. The cheap closed-form inverse serves whenever det(M'M) / prod(diag) > 1e-12,
 // which rules that out.
 template <int Z>
-void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCore& b,
-                      const CoreSolution& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
+void add_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
+                      const ClosestFeature& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
                       Matrix3x14& dp2) {
   const int z1 = sa.free_dimensions;
   Eigen::Matrix<double, 3, Z> M;
@@ -103,8 +95,8 @@ void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCor
   }
 }
 
-void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCore& b,
-                      const CoreSolution& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
+void add_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
+                      const ClosestFeature& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
                       Matrix3x14& dp2) {
   switch (sa.free_dimensions + sb.free_dimensions) {
     case 1:
@@ -120,26 +112,36 @@ void add_point_motion(const PosedCore& a, const CoreSolution& sa, const PosedCor
   }
 }
 
+// The frame's results (see the header) in the inputs' units.
+void restore_units(const PairFrame& frame, Proximity& result) {
+  const double s = frame.scale;
+  result.phi = result.phi * s * s;  // two products: s * s alone may underflow where phi does not
+  result.gradient.segment<3>(0) *= s;
+  result.gradient.segment<4>(3) *= s * s;
+  result.gradient.segment<3>(7) *= s;
+  result.gradient.segment<4>(10) *= s * s;
+}
+
 }  // namespace
 
-Proximity make_proximity(const PosedCore& a, const CoreSolution& solution_a, const PosedCore& b,
-                         const CoreSolution& solution_b) {
+Proximity make_proximity(const PairFrame& frame, const Pose& pose_a, const PosedCore& a,
+                         const ClosestFeature& side_a, const Pose& pose_b, const PosedCore& b,
+                         const ClosestFeature& side_b) {
   Proximity result;
-  const Eigen::Vector3d p1 = a.r + a.attitude.matrix() * solution_a.body_point;
-  const Eigen::Vector3d p2 = b.r + b.attitude.matrix() * solution_b.body_point;
+  const Eigen::Vector3d offset_a = a.attitude.matrix() * side_a.body_point;  // Q u, frame units
+  const Eigen::Vector3d offset_b = b.attitude.matrix() * side_b.body_point;
+  const Eigen::Vector3d p1 = a.r + offset_a;
+  const Eigen::Vector3d p2 = b.r + offset_b;
   const Eigen::Vector3d difference = p1 - p2;
   const double radius_sum = a.radius + b.radius;
   result.phi = difference.squaredNorm() - radius_sum * radius_sum;  // eq. caps_prox
-  result.core_points = {p1, p2};
   // Envelope theorem: d phi = 2 (p1 - p2)' (dp1 - dp2) with the body points held fixed.
   result.gradient.segment<3>(0) = 2.0 * difference;
-  result.gradient.segment<4>(3) =
-      2.0 * a.attitude.rotate_gradient(solution_a.body_point, difference);
+  result.gradient.segment<4>(3) = 2.0 * a.attitude.rotate_gradient(side_a.body_point, difference);
   result.gradient.segment<3>(7) = -2.0 * difference;
-  result.gradient.segment<4>(10) =
-      -2.0 * b.attitude.rotate_gradient(solution_b.body_point, difference);
+  result.gradient.segment<4>(10) = -2.0 * b.attitude.rotate_gradient(side_b.body_point, difference);
 
-  switch (normal_rule(a, b, p1, p2)) {
+  switch (normal_rule(frame, a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
       result.normal = difference * (-1.0 / difference.norm());  // one division, not three
       break;
@@ -152,25 +154,29 @@ Proximity make_proximity(const PosedCore& a, const CoreSolution& solution_a, con
       result.normal = a.attitude.matrix().col(2);
       break;
   }
-  result.points = {p1 + a.radius * result.normal, p2 - b.radius * result.normal};  // caps_c_1/2
+  restore_units(frame, result);
+  result.core_points = {pose_a.r() + frame.scale * offset_a, pose_b.r() + frame.scale * offset_b};
+  const double radius_a = frame.scale * a.radius, radius_b = frame.scale * b.radius;
+  result.points = {result.core_points[0] + radius_a * result.normal,
+                   result.core_points[1] - radius_b * result.normal};  // eqs. caps_c_1, caps_c_2
   return result;
 }
 
-ProximityJacobian make_proximity_jacobian(const PosedCore& a, const CoreSolution& solution_a,
-                                          const PosedCore& b, const CoreSolution& solution_b) {
+ProximityJacobian make_proximity_jacobian(const PairFrame& frame, const Pose& pose_a,
+                                          const PosedCore& a, const ClosestFeature& side_a,
+                                          const Pose& pose_b, const PosedCore& b,
+                                          const ClosestFeature& side_b) {
   ProximityJacobian result;
-  static_cast<Proximity&>(result) = make_proximity(a, solution_a, b, solution_b);
-  const Eigen::Vector3d& p1 = result.core_points[0];
-  const Eigen::Vector3d& p2 = result.core_points[1];
+  static_cast<Proximity&>(result) = make_proximity(frame, pose_a, a, side_a, pose_b, b, side_b);
+  const Eigen::Vector3d p1 = a.r + a.attitude.matrix() * side_a.body_point;
+  const Eigen::Vector3d p2 = b.r + b.attitude.matrix() * side_b.body_point;
 
-  Matrix3x14 dp1 = fixed_point_jacobian(a, solution_a, 0);
-  Matrix3x14 dp2 = fixed_point_jacobian(b, solution_b, 7);
-  add_point_motion(a, solution_a, b, solution_b, p1 - p2, dp1, dp2);
-  result.core_points_jacobian.topRows<3>() = dp1;
-  result.core_points_jacobian.bottomRows<3>() = dp2;
+  Matrix3x14 dp1 = fixed_point_jacobian(a, side_a, 0);
+  Matrix3x14 dp2 = fixed_point_jacobian(b, side_b, 7);
+  add_point_motion(a, side_a, b, side_b, p1 - p2, dp1, dp2);
 
   Matrix3x14 dnormal = Matrix3x14::Zero();
-  switch (normal_rule(a, b, p1, p2)) {
+  switch (normal_rule(frame, a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
       dnormal = unit_vector_motion(p2 - p1, dp2 - dp1);
       break;
@@ -185,8 +191,15 @@ ProximityJacobian make_proximity_jacobian(const PosedCore& a, const CoreSolution
       dnormal.block<3, 4>(0, 3) = a.attitude.rotate_jacobian(Eigen::Vector3d::UnitZ());
       break;
   }
+  result.core_points_jacobian.topRows<3>() = dp1;
+  result.core_points_jacobian.bottomRows<3>() = dp2;
   result.points_jacobian.topRows<3>() = dp1 + a.radius * dnormal;
   result.points_jacobian.bottomRows<3>() = dp2 - b.radius * dnormal;
+  // d/dr is free of units (a length per length), d/dq is a length: the quaternion columns scale.
+  for (const int column : {3, 10}) {
+    result.core_points_jacobian.middleCols<4>(column) *= frame.scale;
+    result.points_jacobian.middleCols<4>(column) *= frame.scale;
+  }
   return result;
 }
 

@@ -35,13 +35,13 @@ PairSolution solve_pair(const PairProblem& problem) {
   return solution;
 }
 
-std::array<CoreSolution, 2> core_solutions(const PairProblem& problem,
-                                           const PairSolution& solution) {
-  std::array<CoreSolution, 2> sides;
+std::array<ClosestFeature, 2> core_solutions(const PairProblem& problem,
+                                             const PairSolution& solution) {
+  std::array<ClosestFeature, 2> sides;
   Eigen::Index row = 0;
   for (int i = 0; i < 2; ++i) {
-    const Core& core = *problem.cores[static_cast<std::size_t>(i)];
-    CoreSolution& side = sides[static_cast<std::size_t>(i)];
+    const ParametricCore& core = *problem.cores[static_cast<std::size_t>(i)];
+    ClosestFeature& side = sides[static_cast<std::size_t>(i)];
     side.body_point = problem.body_point(i, solution.x);
     int active = 0;
     Eigen::Index last_active = 0;

@@ -4,9 +4,9 @@
 #include <Eigen/Core>
 #include <array>
 
-#include "core_solution.hpp"
 #include "diffpills/proximity.hpp"
 #include "pair_problem.hpp"
+#include "posed_core.hpp"
 
 namespace diffpills::detail {
 
@@ -23,7 +23,7 @@ PairSolution solve_pair(const PairProblem& problem);
 // the body directions its active rows leave free (a segment: its axis unless a bound is active;
 // a polygon: the face plane with no active row, the row's edge tangent with one, none with two,
 // which with non-redundant rows means a vertex).
-std::array<CoreSolution, 2> core_solutions(const PairProblem& problem,
-                                           const PairSolution& solution);
+std::array<ClosestFeature, 2> core_solutions(const PairProblem& problem,
+                                             const PairSolution& solution);
 
 }  // namespace diffpills::detail

@@ -1,44 +1,104 @@
 // Feature-level geometry of a reduced polygon in its own body frame (the x-y plane), for the
-// fast paths: edges, inside tests, clipping. Row j of edge_normals() bounds edge j, which runs
+// fast paths: edges, inside tests, clipping. Edge j is bounded by row j of edge_normals() and runs
 // counterclockwise from vertex j - 1 to vertex j (vertex i joins edges i and i + 1).
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
-#include <vector>
 
-#include "core_solution.hpp"
 #include "diffpills/shapes.hpp"
+#include "posed_core.hpp"
+#include "segment_segment.hpp"
 
 namespace diffpills::detail {
 
-// Start and end vertex of edge j.
-Eigen::Vector2d edge_start(const PaddedPolygon& polygon, Eigen::Index j);
-Eigen::Vector2d edge_end(const PaddedPolygon& polygon, Eigen::Index j);
+// A polygon in the units of a query's frame (pair_frame.hpp): every length multiplied by `scale`,
+// a power of two, so exactly. Nothing is copied.
+class PolygonView {
+ public:
+  PolygonView(const PaddedPolygon& polygon, double scale) : polygon_(&polygon), scale_(scale) {}
 
-// Is y in the closed polygon? Exact comparisons: the fast paths need no tolerance here, because
-// a point on the boundary is also found by the edge candidates.
-bool contains(const PaddedPolygon& polygon, const Eigen::Vector2d& y);
+  Eigen::Index size() const { return polygon_->vertices().rows(); }  // vertices = edges
+  Eigen::Vector2d vertex(Eigen::Index i) const {
+    return {scale_ * polygon_->vertices()(i, 0), scale_ * polygon_->vertices()(i, 1)};
+  }
+  Eigen::Vector2d normal(Eigen::Index j) const {  // unit, outward
+    return {polygon_->edge_normals()(j, 0), polygon_->edge_normals()(j, 1)};
+  }
+  double offset(Eigen::Index j) const { return scale_ * polygon_->edge_offsets()(j); }
+  double extent() const { return scale_ * polygon_->extent(); }
+  Eigen::Index previous(Eigen::Index i) const { return i == 0 ? size() - 1 : i - 1; }
+  Eigen::Index next(Eigen::Index i) const { return i + 1 == size() ? 0 : i + 1; }
+  Eigen::Vector2d edge_start(Eigen::Index j) const { return vertex(previous(j)); }
+  Eigen::Vector2d edge_end(Eigen::Index j) const { return vertex(j); }
+  // The edge's unit direction, the outward normal turned a quarter counterclockwise.
+  Eigen::Vector2d edge_direction(Eigen::Index j) const {
+    const Eigen::Vector2d n = normal(j);
+    return {-n.y(), n.x()};
+  }
+  // Edge j as a segment of the body frame (z = 0), its length without a square root.
+  Segment edge(Eigen::Index j) const;
+  // Every edge of the polygon is one of its edges (a SubPolygon also has chords).
+  bool is_edge(Eigen::Index) const { return true; }
 
-// The parameter interval {s in [0, 1] : y0 + s w in the polygon} (Cyrus-Beck clipping); empty
-// when the returned low > high.
-std::array<double, 2> clip_line(const PaddedPolygon& polygon, const Eigen::Vector2d& y0,
-                                const Eigen::Vector2d& w);
+ private:
+  const PaddedPolygon* polygon_;
+  double scale_;
+};
 
-// The centre of the convex region polygon /\ {other's vertices}: the area centroid when the
-// region has area, else the mean of its vertices (a segment or a point where the outlines only
-// touch). `other` lists a convex polygon's vertices counterclockwise. Returns false if the two
-// do not overlap.
-bool overlap_centre(const PaddedPolygon& polygon, const std::vector<Eigen::Vector2d>& other,
-                    Eigen::Vector2d& centre);
+// Is y in the polygon grown by `slack` (every row n . y <= b + slack)? Polygon is a PolygonView
+// or a SubPolygon (sub_polygon.hpp).
+template <class Polygon>
+bool contains(const Polygon& polygon, const Eigen::Vector2d& y, double slack) {
+  for (Eigen::Index j = 0; j < polygon.size(); ++j) {
+    if (polygon.normal(j).dot(y) > polygon.offset(j) + slack) return false;
+  }
+  return true;
+}
+
+// The parameter interval {s in [0, 1] : y0 + s w in the polygon grown by `slack`} (Cyrus-Beck
+// clipping); empty when the returned low > high. Each row n.(y0 + s w) <= b + slack bounds s from
+// one side: s <= room / n.w when n.w > 0, from below when n.w < 0; a row parallel to w either
+// holds for every s or for none.
+template <class Polygon>
+std::array<double, 2> clip_line(const Polygon& polygon, const Eigen::Vector2d& y0,
+                                const Eigen::Vector2d& w, double slack) {
+  double low = 0.0, high = 1.0;
+  for (Eigen::Index j = 0; j < polygon.size() && low <= high; ++j) {
+    const Eigen::Vector2d n = polygon.normal(j);
+    const double along = n.dot(w);
+    const double room = polygon.offset(j) + slack - n.dot(y0);
+    if (along > 0.0) {
+      high = std::min(high, room / along);
+    } else if (along < 0.0) {
+      low = std::max(low, room / along);
+    } else if (room < 0.0) {
+      return {1.0, 0.0};
+    }
+  }
+  return {low, high};
+}
 
 // The side of a polygon whose closest point is y: a face point (free in the body x-y plane), a
 // point of edge j (free along it) or vertex j (fixed).
-CoreSolution face_point(const Eigen::Vector2d& y);
-CoreSolution edge_point(const PaddedPolygon& polygon, Eigen::Index j, double t);
+ClosestFeature face_point(const Eigen::Vector2d& y);
+template <class Polygon>
+ClosestFeature edge_point(const Polygon& polygon, Eigen::Index j, double t) {
+  const Eigen::Vector2d start = polygon.edge_start(j), end = polygon.edge_end(j);
+  const Eigen::Vector2d point = start + t * (end - start);
+  if (t > 0.0 && t < 1.0 && !polygon.is_edge(j)) return face_point(point);  // inside a chord
+  ClosestFeature side;
+  side.body_point << point, 0.0;
+  if (t > 0.0 && t < 1.0) {
+    side.free_dimensions = 1;
+    side.free_directions.col(0) << polygon.edge_direction(j), 0.0;
+  }
+  return side;
+}
 
 // The side of a capsule of `length` at parameter s (u = [(s - 1/2) L, 0, 0]): free along its
 // axis strictly inside, fixed at an end or for a sphere.
-CoreSolution segment_point(double length, double s);
+ClosestFeature segment_point(double length, double s);
 
 }  // namespace diffpills::detail

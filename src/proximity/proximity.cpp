@@ -1,4 +1,5 @@
-// The public queries. Method::kDefault sends each pair to its exact fast solver (fast_paths.hpp);
+// The public queries. Each builds the pair's frame (pair_frame.hpp) and its two posed cores, then
+// Method::kDefault sends the pair to its exact fast solver (fast_paths.hpp) and
 // Method::kInteriorPoint builds the pair's QP (pair_problem.hpp) and solves it with the paper's
 // interior-point method. Both hand the two sides of the solution to the same result builder.
 #include "diffpills/proximity.hpp"
@@ -7,40 +8,71 @@
 #include <utility>
 #include <variant>
 
-#include "core.hpp"
-#include "core_solution.hpp"
 #include "fast_paths.hpp"
+#include "pair_frame.hpp"
 #include "pair_problem.hpp"
 #include "pair_result.hpp"
 #include "pair_solve.hpp"
+#include "parametric_core.hpp"
+#include "polygon_features.hpp"
+#include "posed_core.hpp"
 
 namespace diffpills {
 namespace {
 
-using detail::CoreSolution;
+using detail::ClosestFeature;
+using detail::PairFrame;
+using detail::PolygonView;
 using detail::PosedCore;
-using Sides = std::array<CoreSolution, 2>;
+using Sides = std::array<ClosestFeature, 2>;
 
-Sides fast_sides(const Capsule& a, const PosedCore& pa, const Capsule& b, const PosedCore& pb) {
-  return detail::solve_capsule_capsule(a, pa, b, pb);
+double core_size(const Capsule& capsule) { return capsule.length(); }
+double core_size(const PaddedPolygon& polygon) { return polygon.extent(); }
+
+// The shape's core in the frame: origin moved to `origin`, lengths divided by the frame's scale
+// (multiplied by its exact inverse).
+template <class Shape>
+PosedCore posed_core(const Shape& shape, const Pose& pose, const Eigen::Vector3d& origin,
+                     const PairFrame& frame) {
+  return {(pose.r() - origin) * frame.inverse_scale, detail::UnitQuaternion(pose.q()),
+          shape.radius() * frame.inverse_scale, core_size(shape) * frame.inverse_scale};
 }
-Sides fast_sides(const Capsule& a, const PosedCore& pa, const PaddedPolygon& b,
-                 const PosedCore& pb) {
-  return detail::solve_capsule_polygon(a, pa, b, pb);
+
+Sides fast_sides(const Capsule&, const PosedCore& pa, const Capsule&, const PosedCore& pb,
+                 const PairFrame&) {
+  return detail::solve_capsule_capsule(pa, pb);
 }
-Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Capsule& b,
-                 const PosedCore& pb) {
-  const Sides swapped = detail::solve_capsule_polygon(b, pb, a, pa);
+Sides fast_sides(const Capsule&, const PosedCore& pa, const PaddedPolygon& b, const PosedCore& pb,
+                 const PairFrame& frame) {
+  return detail::solve_capsule_polygon(pa, PolygonView(b, frame.inverse_scale), pb,
+                                       frame.tolerance);
+}
+Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Capsule&, const PosedCore& pb,
+                 const PairFrame& frame) {
+  const Sides swapped =
+      detail::solve_capsule_polygon(pb, PolygonView(a, frame.inverse_scale), pa, frame.tolerance);
   return {swapped[1], swapped[0]};
 }
 Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const PaddedPolygon& b,
-                 const PosedCore& pb) {
-  return detail::solve_polygon_polygon(a, pa, b, pb);
+                 const PosedCore& pb, const PairFrame& frame) {
+  return detail::solve_polygon_polygon(PolygonView(a, frame.inverse_scale), pa,
+                                       PolygonView(b, frame.inverse_scale), pb, frame.tolerance);
 }
 
-Sides reference_sides(const detail::Core& core_a, const Pose& pose_a, const detail::Core& core_b,
-                      const Pose& pose_b) {
-  const detail::PairProblem problem = detail::make_pair_problem(core_a, pose_a, core_b, pose_b);
+detail::ParametricCore parametric_core(const Capsule&, const PosedCore& posed, const PairFrame&) {
+  return detail::make_parametric_capsule(posed.size);
+}
+detail::ParametricCore parametric_core(const PaddedPolygon& polygon, const PosedCore&,
+                                       const PairFrame& frame) {
+  return detail::make_parametric_polygon(PolygonView(polygon, frame.inverse_scale));
+}
+
+template <class ShapeA, class ShapeB>
+Sides reference_sides(const ShapeA& a, const PosedCore& pa, const ShapeB& b, const PosedCore& pb,
+                      const PairFrame& frame) {
+  const detail::ParametricCore core_a = parametric_core(a, pa, frame);
+  const detail::ParametricCore core_b = parametric_core(b, pb, frame);
+  const detail::PairProblem problem = detail::make_pair_problem(core_a, pa, core_b, pb);
   return detail::core_solutions(problem, detail::solve_pair(problem));
 }
 
@@ -48,16 +80,18 @@ Sides reference_sides(const detail::Core& core_a, const Pose& pose_a, const deta
 template <class Result, class ShapeA, class ShapeB>
 Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& pose_b,
              const ProximityOptions& options) {
-  const PosedCore posed_a = detail::posed_core(a, pose_a);
-  const PosedCore posed_b = detail::posed_core(b, pose_b);
-  const Sides sides =
-      options.method == Method::kInteriorPoint
-          ? reference_sides(detail::make_core(a), pose_a, detail::make_core(b), pose_b)
-          : fast_sides(a, posed_a, b, posed_b);
+  const PairFrame frame = detail::make_pair_frame(core_size(a), a.radius(), core_size(b),
+                                                  b.radius(), pose_a.r(), pose_b.r());
+  const PosedCore posed_a = posed_core(a, pose_a, pose_a.r(), frame);
+  const PosedCore posed_b = posed_core(b, pose_b, pose_a.r(), frame);
+  const Sides sides = options.method == Method::kInteriorPoint
+                          ? reference_sides(a, posed_a, b, posed_b, frame)
+                          : fast_sides(a, posed_a, b, posed_b, frame);
   if constexpr (std::is_same_v<Result, ProximityJacobian>) {
-    return detail::make_proximity_jacobian(posed_a, sides[0], posed_b, sides[1]);
+    return detail::make_proximity_jacobian(frame, pose_a, posed_a, sides[0], pose_b, posed_b,
+                                           sides[1]);
   } else {
-    return detail::make_proximity(posed_a, sides[0], posed_b, sides[1]);
+    return detail::make_proximity(frame, pose_a, posed_a, sides[0], pose_b, posed_b, sides[1]);
   }
 }
 

@@ -7,86 +7,106 @@
 namespace diffpills::detail {
 namespace {
 
-double clamp01(double value) { return std::clamp(value, 0.0, 1.0); }
+double clamp(double value, double high) { return std::clamp(value, 0.0, high); }
 
 }  // namespace
 
-// With w = p - q the squared distance is |w + s u - t v|^2, and with
-//   a = u.u,  b = u.v,  e = v.v,  c = u.w,  f = v.w
-// its stationary point solves  a s - b t = -c,  b s - e t = -f,  determinant
-// a e - b^2 = |u x v|^2 = a e sin^2 (taken from the cross product, free of cancellation).
-// Three regimes by the angle between the segments:
-//   - sin^2 > 1e-6 (Ericson, Real-Time Collision Detection 5.1.9): s from the stationary point,
-//     clamped; t = (b s + f) / e, the best t for it; if t leaves [0, 1] it is clamped and s made
-//     the best s for it. Exact, and the stationary point is accurate to 1e-10 relative.
-//   - near parallel: the stationary point carries a relative error of eps / sin^2, enough to
-//     clamp to the wrong end. The Appendix A candidates are compared instead, each distance
-//     evaluated directly: the stationary point if it lies in the box, and the best point of each
-//     side of the box (a clamped projection).
-//   - parallel, |sin| <= 1e-12: see the header. The threshold is on the sine, not its square:
-//     for coplanar segments the distance changes linearly along the overlap, with slope ~ sin, so
-//     the middle of the overlap is within ~1e-12 |u| of the optimum only at this threshold.
-SegmentParameters closest_segment_parameters(const Eigen::Vector3d& p, const Eigen::Vector3d& u,
-                                             const Eigen::Vector3d& q, const Eigen::Vector3d& v) {
-  const Eigen::Vector3d w = p - q;
-  const double a = u.squaredNorm();
-  const double e = v.squaredNorm();
-  const double b = u.dot(v);
-  const double c = u.dot(w);
-  const double f = v.dot(w);
+// In length units: P(s) = p + s u, Q(t) = q + t v with unit u, v, s in [0, a], t in [0, b], and
+// w = p - q. The squared distance is |w + s u - t v|^2; with cos = u.v, c = u.w, f = v.w the best
+// t for a given s is f + s cos and the best s for a given t is t cos - c.
+//
+// The stationary point (eq. capsule_opt without bounds). With n = u x v, |n| = sin of the angle,
+// crossing w + s u - t v = lambda n with v and dotting with n gives
+//   s* = -((w x v) . n) / |n|^2,   and t* = f + s* cos, the best partner of s*.
+// The order of the products matters. w x v is the part of w across v, small when the segments are
+// nearly parallel (of order theta a + D, D the distance of the lines) but computed to eps |w|;
+// dotting it with the small n adds eps (theta a + D). So s* errs by eps (|w| / theta + D /
+// theta^2): eps / theta for lines that nearly meet, the conditioning of the problem itself, against
+// eps / theta^2 from the Gram system (a s - b t = -c, b s - e t = -f solved by Cramer's rule, whose
+// numerator b f - c e cancels to that level). Associating as w . (v x n) would lose the same way.
+// t* is taken as the best partner of s* rather than from its own formula -((w x u) . n) / |n|^2:
+// the two errors of order eps / theta would be independent, moving the points apart across the
+// lines by that much, while a partner shifts with s* along the nearly common direction and the
+// distance stays exact to eps.
+//
+// Three regimes by the angle:
+//   - sin > 1e-3: Ericson's clamping (Real-Time Collision Detection 5.1.9): s* clamped, t the
+//     best t for it; if t leaves [0, b] it is clamped and s made the best s for it. Exact for
+//     non-parallel segments, and s* is accurate to ~1e-13 relative here.
+//   - 1e-12 < sin <= 1e-3: the distance varies slowly along the segments, and a clamp decided on
+//     a slightly wrong side costs a distance error of order theta a. Appendix A's candidates are
+//     compared by their distances instead: the stationary point if it lies in the box, and the
+//     best point of each side of the box (a clamped projection).
+//   - parallel, sin <= 1e-12: see the header. The threshold is on the sine, not its square: for
+//     coplanar segments the distance changes linearly along the overlap, with slope ~ sin, so the
+//     middle of the overlap is within ~1e-12 a of the optimum only at this threshold.
+// Every quantity is of degree at most two in lengths (distances squared), so no length accepted
+// by the library (up to 1e100) overflows or underflows.
+SegmentParameters closest_segment_parameters(const Segment& P, const Segment& Q) {
+  const double a = P.length, b = Q.length;
+  const Eigen::Vector3d& u = P.direction;
+  const Eigen::Vector3d& v = Q.direction;
+  const Eigen::Vector3d w = P.start - Q.start;
+  const double c = u.dot(w), f = v.dot(w), cos = u.dot(v);
   SegmentParameters out;
-  if (a == 0.0 && e == 0.0) return out;
+  if (a == 0.0 && b == 0.0) return out;
   if (a == 0.0) {
-    out.t = clamp01((f + 0.5 * b) / e);  // the best t for the point p + u / 2 = p
+    out.t = clamp(f, b) / b;
     return out;
   }
-  if (e == 0.0) {
-    out.s = clamp01((0.5 * b - c) / a);
+  if (b == 0.0) {
+    out.s = clamp(-c, a) / a;
     return out;
   }
-  const double det = u.cross(v).squaredNorm();
-  if (det > 1e-6 * a * e) {
-    out.s = clamp01((b * f - c * e) / det);
-    out.t = (b * out.s + f) / e;
-    if (out.t < 0.0) {
-      out.t = 0.0;
-      out.s = clamp01(-c / a);
-    } else if (out.t > 1.0) {
-      out.t = 1.0;
-      out.s = clamp01((b - c) / a);
+  const Eigen::Vector3d n = u.cross(v);
+  const double sin2 = n.squaredNorm();
+  const auto best_t = [&](double s) { return clamp(f + s * cos, b); };
+  const auto best_s = [&](double t) { return clamp(t * cos - c, a); };
+  double s = 0.0, t = 0.0;
+  if (sin2 > 1e-6) {
+    s = clamp(-w.cross(v).dot(n) / sin2, a);
+    t = f + s * cos;
+    if (t < 0.0 || t > b) {
+      t = clamp(t, b);
+      s = best_s(t);
     }
-    return out;
-  }
-  if (det > 1e-24 * a * e) {
-    const auto distance2 = [&](const SegmentParameters& x) {
-      return (w + x.s * u - x.t * v).squaredNorm();
+  } else if (sin2 > 1e-24) {
+    const auto distance2 = [&](double s_, double t_) {
+      return (w + s_ * u - t_ * v).squaredNorm();
     };
-    const std::array<SegmentParameters, 4> sides = {
-        SegmentParameters{0.0, clamp01(f / e)}, SegmentParameters{1.0, clamp01((b + f) / e)},
-        SegmentParameters{clamp01(-c / a), 0.0}, SegmentParameters{clamp01((b - c) / a), 1.0}};
-    out = sides[0];
-    for (const SegmentParameters& side : sides) {
-      if (distance2(side) < distance2(out)) out = side;
+    const std::array<std::array<double, 2>, 4> sides = {
+        {{0.0, best_t(0.0)}, {a, best_t(a)}, {best_s(0.0), 0.0}, {best_s(b), b}}};
+    double best = distance2(sides[0][0], sides[0][1]);
+    s = sides[0][0], t = sides[0][1];
+    for (const auto& [s_side, t_side] : sides) {
+      const double d2 = distance2(s_side, t_side);
+      if (d2 < best) best = d2, s = s_side, t = t_side;
     }
-    const double s = (b * f - c * e) / det;
-    const double t = (b * s + f) / e;
-    if (s >= 0.0 && s <= 1.0 && t >= 0.0 && t <= 1.0 && distance2({s, t}) < distance2(out)) {
-      out = {s, t};
+    const double s_star = -w.cross(v).dot(n) / sin2;
+    const double t_star = f + s_star * cos;  // the best partner of s*, not t*'s own formula
+    if (s_star >= 0.0 && s_star <= a && t_star >= 0.0 && t_star <= b &&
+        distance2(s_star, t_star) < best) {
+      s = s_star, t = t_star;
     }
-    return out;
+  } else {
+    // Parallel: the ends of Q project onto P's line at s0 (t = 0) and s1 (t = b). Where the
+    // projections overlap [0, a], every s of the overlap has a partner at the same distance and
+    // the middle of the overlap is returned; otherwise the facing ends are unique.
+    const double s0 = -c, s1 = b * cos - c;
+    const double low = std::max(0.0, std::min(s0, s1));
+    const double high = std::min(a, std::max(s0, s1));
+    if (low <= high) {
+      s = 0.5 * (low + high);
+      t = best_t(s);
+      out.overlap = low < high;
+    } else {
+      s = clamp(0.5 * (s0 + s1), a);
+      t = best_t(s);
+      s = best_s(t);
+    }
   }
-  // Parallel: the ends of Q project onto P's line at s0 (t = 0) and s1 (t = 1). Where the
-  // projections overlap [0, 1], every s of the overlap has a partner at the same distance and the
-  // middle of the overlap is returned; otherwise the facing ends are unique.
-  const double s0 = -c / a;
-  const double s1 = (b - c) / a;
-  const double low = std::max(0.0, std::min(s0, s1));
-  const double high = std::min(1.0, std::max(s0, s1));
-  out.s = low <= high ? 0.5 * (low + high) : clamp01(0.5 * (s0 + s1));
-  out.t = clamp01((b * out.s + f) / e);
-  if (low > high) {
-    out.s = clamp01((b * out.t - c) / a);
-  }
+  out.s = s / a;
+  out.t = t / b;
   return out;
 }
 

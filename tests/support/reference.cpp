@@ -50,12 +50,15 @@ ClosestPair segment_segment(const Segment& s, const Segment& t) {
   return best;
 }
 
+// Newell's method about the first vertex (about the world origin, the cross products of a tiny
+// polygon far away would cancel), scaled by its largest component before normalizing so that a
+// polygon of any size keeps a unit normal.
 Vec3L polygon_normal(const std::vector<Vec3L>& v) {
   Vec3L n = Vec3L::Zero();
-  for (std::size_t i = 0; i < v.size(); ++i) {  // Newell's method
-    n += v[i].cross(v[(i + 1) % v.size()]);
+  for (std::size_t i = 1; i + 1 < v.size(); ++i) {
+    n += (v[i] - v[0]).cross(v[i + 1] - v[0]);
   }
-  return n.normalized();
+  return (n / n.cwiseAbs().maxCoeff()).normalized();
 }
 
 // Is a point of the polygon's plane inside the (counterclockwise about n) polygon?

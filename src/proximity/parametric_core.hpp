@@ -1,4 +1,5 @@
-// A shape's core as the affine image of a small parameter polytope, in the body frame:
+// A shape's core as the affine image of a small parameter polytope, in the body frame and in the
+// units of a query's frame (pair_frame.hpp), for the reference path (the paper's QPs):
 //
 //     u(x) = U x + u0,   G x <= h,      world point  p = r + Q(q) u(x)
 //
@@ -14,11 +15,11 @@
 
 #include <Eigen/Core>
 
-#include "diffpills/shapes.hpp"
+#include "polygon_features.hpp"
 
 namespace diffpills::detail {
 
-struct Core {
+struct ParametricCore {
   int dim = 0;                                                          // 0, 1 or 2 parameters
   Eigen::Matrix<double, 3, 2> U = Eigen::Matrix<double, 3, 2>::Zero();  // first dim columns used
   Eigen::Vector3d u0 = Eigen::Vector3d::Zero();
@@ -27,7 +28,8 @@ struct Core {
   double size = 0.0;  // length scale: the capsule's length or the polygon's extent
 };
 
-Core make_core(const Capsule& capsule);
-Core make_core(const PaddedPolygon& polygon);
+// A capsule of the given length (a sphere for 0), and a polygon.
+ParametricCore make_parametric_capsule(double length);
+ParametricCore make_parametric_polygon(const PolygonView& polygon);
 
 }  // namespace diffpills::detail

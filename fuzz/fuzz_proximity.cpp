@@ -1,0 +1,250 @@
+// libFuzzer target: bytes -> two shapes and poses -> every query the library offers, with the
+// invariants every answer must keep (issue 9).
+//
+// Decoding. Numbers come from the bytes in four ways, so that the fuzzer reaches both generic and
+// hostile inputs quickly: any double (inf and NaN included), a small multiple of 1/8 (exact, so
+// that shapes line up: parallel, coplanar, stacked, touching), a signed power of two of any
+// exponent (1e-300 .. 1e100 and beyond the accepted range), or one of a list of edge values.
+// Attitudes are drawn the same way, or from the 24 rotations of a cube (aligned features).
+//
+// Checked, for every ordering of the two shapes and both methods:
+//   - only documented exceptions: std::invalid_argument from construction (bad sizes, unbounded
+//     polygons, zero or non-finite quaternions), SolverError from the interior-point method;
+//   - finite phi, points, gradient and Jacobians; a unit normal; phi >= -(R1 + R2)^2;
+//   - swap symmetry: proximity(b, a) has the same phi and the points swapped;
+//   - the interior-point reference agrees with the default path on phi;
+//   - proximity_batch over a few rows and threads equals the single calls bit for bit.
+#include <fuzzer/FuzzedDataProvider.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "diffpills/diffpills.hpp"
+
+namespace {
+
+using diffpills::Capsule;
+using diffpills::PaddedPolygon;
+using diffpills::Pose;
+using diffpills::Shape;
+
+// The decoded inputs of the current run, printed with a failure so that it can be reproduced.
+std::string g_inputs;
+
+std::string describe(const Shape& shape, const Pose& pose) {
+  std::string text;
+  char number[32];
+  const auto add = [&](double value) {
+    std::snprintf(number, sizeof number, "%.17g, ", value);
+    text += number;
+  };
+  if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+    text += "Capsule(";
+    add(capsule->length());
+    add(capsule->radius());
+  } else {
+    const auto& polygon = std::get<PaddedPolygon>(shape);
+    // A regular polygon of many rows is described by its first rows (its d are all equal).
+    const Eigen::Index rows = std::min<Eigen::Index>(polygon.constraint_matrix().rows(), 64);
+    text += "PaddedPolygon(" + std::to_string(polygon.constraint_matrix().rows()) + " rows, C = [";
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      add(polygon.constraint_matrix()(i, 0));
+      add(polygon.constraint_matrix()(i, 1));
+    }
+    text += "], d = [";
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      add(polygon.constraint_offsets()(i));
+    }
+    text += "], radius = ";
+    add(polygon.radius());
+  }
+  text += ") at r = [";
+  for (int i = 0; i < 3; ++i) add(pose.r()(i));
+  text += "], q = [";
+  for (int i = 0; i < 4; ++i) add(pose.q()(i));
+  return text + "]\n";
+}
+
+[[noreturn]] void violated(const char* what, double value) {
+  std::fprintf(stderr, "invariant violated: %s (%.17g)\n%s", what, value, g_inputs.c_str());
+  std::abort();
+}
+
+void check(bool holds, const char* what, double value = 0.0) {
+  if (!holds) violated(what, value);
+}
+
+double take_number(FuzzedDataProvider& data) {
+  static constexpr std::array<double, 14> kEdges = {
+      0.0,     -0.0,     1.0,   -1.0,   1e-300, 5e-324, 1e100, -1e100, 1.0000000000000002e100,
+      1e-100, 2.2e-308, 1e300, 0.5, std::numeric_limits<double>::quiet_NaN()};
+  switch (data.ConsumeIntegralInRange<int>(0, 4)) {
+    case 0: {
+      double value = 0.0;
+      const auto bytes = data.ConsumeBytes<std::uint8_t>(sizeof value);
+      std::copy(bytes.begin(), bytes.end(), reinterpret_cast<std::uint8_t*>(&value));
+      return value;
+    }
+    case 1:
+    case 2:
+      return data.ConsumeIntegralInRange<int>(-24, 24) / 8.0;
+    case 3:
+      return std::ldexp(data.ConsumeIntegralInRange<int>(-3, 3),
+                        data.ConsumeIntegralInRange<int>(-1100, 1100));
+    default:
+      return data.PickValueInArray(kEdges);
+  }
+}
+
+Eigen::Vector4d take_quaternion(FuzzedDataProvider& data) {
+  if (data.ConsumeBool()) {
+    // Products of quarter turns about the axes: the 24 rotations of a cube, and their negatives.
+    static const double h = std::sqrt(0.5);
+    static const std::array<Eigen::Vector4d, 10> kQuarterTurns = {
+        Eigen::Vector4d(1, 0, 0, 0),  Eigen::Vector4d(h, h, 0, 0),  Eigen::Vector4d(h, 0, h, 0),
+        Eigen::Vector4d(h, 0, 0, h),  Eigen::Vector4d(0, 1, 0, 0),  Eigen::Vector4d(0, 0, 1, 0),
+        Eigen::Vector4d(0, 0, 0, 1),  Eigen::Vector4d(0.5, 0.5, 0.5, 0.5),
+        Eigen::Vector4d(h, -h, 0, 0), Eigen::Vector4d(-0.5, 0.5, -0.5, 0.5)};
+    return data.PickValueInArray(kQuarterTurns);
+  }
+  Eigen::Vector4d q;
+  for (int i = 0; i < 4; ++i) q(i) = take_number(data);
+  return q;
+}
+
+Pose take_pose(FuzzedDataProvider& data) {
+  Eigen::Vector3d r;
+  for (int i = 0; i < 3; ++i) r(i) = take_number(data);
+  return Pose(r, take_quaternion(data));
+}
+
+// A capsule, or a polygon of 0 to 40 rows (sometimes a regular polygon of up to 2,000 rows, for
+// the large-polygon path), from numbers or from unit normals at angles taken from the bytes.
+Shape take_shape(FuzzedDataProvider& data) {
+  if (data.ConsumeBool()) return Capsule(take_number(data), take_number(data));
+  const double radius = take_number(data);
+  if (data.ConsumeIntegralInRange<int>(0, 7) == 0) {
+    const int count = data.ConsumeIntegralInRange<int>(3, 2000);
+    const double offset = take_number(data);
+    Eigen::MatrixX2d C(count, 2);
+    for (int i = 0; i < count; ++i) {
+      C.row(i) << std::cos(2 * M_PI * i / count), std::sin(2 * M_PI * i / count);
+    }
+    return PaddedPolygon(C, Eigen::VectorXd::Constant(count, offset), radius);
+  }
+  const int rows = data.ConsumeIntegralInRange<int>(0, 40);
+  Eigen::MatrixX2d C(rows, 2);
+  Eigen::VectorXd d(rows);
+  const bool by_angle = data.ConsumeBool();
+  for (int i = 0; i < rows; ++i) {
+    if (by_angle) {
+      const double angle = 2 * M_PI * data.ConsumeIntegralInRange<int>(0, 4095) / 4096.0;
+      C.row(i) << std::cos(angle), std::sin(angle);
+    } else {
+      C.row(i) << take_number(data), take_number(data);
+    }
+    d(i) = take_number(data);
+  }
+  return PaddedPolygon(C, d, radius);
+}
+
+double radius_of(const Shape& shape) {
+  return std::visit([](const auto& s) { return s.radius(); }, shape);
+}
+
+double size_of(const Shape& shape) {
+  if (const auto* capsule = std::get_if<Capsule>(&shape)) return capsule->length();
+  return std::get<PaddedPolygon>(shape).extent();
+}
+
+void check_result(const diffpills::ProximityJacobian& result, double radii) {
+  check(std::isfinite(result.phi), "phi is finite", result.phi);
+  check(result.gradient.allFinite(), "gradient is finite");
+  check(result.core_points[0].allFinite() && result.core_points[1].allFinite(),
+        "core points are finite");
+  check(result.points[0].allFinite() && result.points[1].allFinite(), "points are finite");
+  check(result.core_points_jacobian.allFinite() && result.points_jacobian.allFinite(),
+        "Jacobians are finite");
+  check(std::abs(result.normal.norm() - 1.0) <= 1e-14, "normal is unit", result.normal.norm());
+  // phi + (R1 + R2)^2 is a squared distance.
+  check(result.phi >= -radii * radii * (1.0 + 1e-15), "phi >= -(R1 + R2)^2", result.phi);
+}
+
+// Every query on one valid pair, with the invariants above.
+void check_queries(FuzzedDataProvider& data, const Shape& a, const Pose& pose_a, const Shape& b,
+                   const Pose& pose_b) {
+  const double radii = radius_of(a) + radius_of(b);
+  // The scene's size: every length of it, so that tolerances are relative.
+  const double scene = std::max({size_of(a), size_of(b), radius_of(a), radius_of(b),
+                                 (pose_a.r() - pose_b.r()).lpNorm<Eigen::Infinity>()});
+
+  const diffpills::ProximityJacobian ab = diffpills::proximity_jacobian(a, pose_a, b, pose_b);
+  const diffpills::ProximityJacobian ba = diffpills::proximity_jacobian(b, pose_b, a, pose_a);
+  check_result(ab, radii);
+  check_result(ba, radii);
+  const double phi_tolerance = 1e-12 * scene * scene;
+  check(std::abs(ab.phi - ba.phi) <= phi_tolerance, "swap symmetry of phi", ab.phi - ba.phi);
+
+  const diffpills::Proximity plain = diffpills::proximity(a, pose_a, b, pose_b);
+  check(plain.phi == ab.phi, "proximity and proximity_jacobian agree", plain.phi - ab.phi);
+
+  try {
+    const diffpills::ProximityJacobian reference =
+        diffpills::proximity_jacobian(a, pose_a, b, pose_b, {diffpills::Method::kInteriorPoint});
+    check_result(reference, radii);
+    check(std::abs(reference.phi - ab.phi) <= 1e-6 * scene * scene,
+          "interior point agrees with the default path", reference.phi - ab.phi);
+  } catch (const diffpills::SolverError&) {
+    // Documented: the interior-point method reports that it did not converge.
+  }
+
+  const Eigen::Index rows = data.ConsumeIntegralInRange<int>(0, 3);
+  diffpills::PositionArray r_a(rows, 3), r_b(rows, 3);
+  diffpills::QuaternionArray q_a(rows, 4), q_b(rows, 4);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    r_a.row(i) = pose_a.r().transpose();
+    q_a.row(i) = pose_a.q().transpose();
+    r_b.row(i) = pose_b.r().transpose();
+    q_b.row(i) = pose_b.q().transpose();
+  }
+  const int threads = data.ConsumeIntegralInRange<int>(0, 3);
+  const diffpills::BatchResult batch =
+      diffpills::proximity_batch(a, r_a, q_a, b, r_b, q_b, {threads});
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    check(batch.phi(i) == plain.phi, "batch equals single calls", batch.phi(i) - plain.phi);
+    check(batch.gradient.row(i).transpose() == plain.gradient, "batch gradient equals single");
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t size) {
+  FuzzedDataProvider data(bytes, size);
+  Shape a = Capsule(0, 0), b = Capsule(0, 0);
+  Pose pose_a, pose_b;
+  try {
+    a = take_shape(data);
+    b = take_shape(data);
+    pose_a = take_pose(data);
+    pose_b = take_pose(data);
+  } catch (const std::invalid_argument&) {
+    return 0;  // rejected input: the documented answer
+  }
+  g_inputs = "a = " + describe(a, pose_a) + "b = " + describe(b, pose_b);
+  try {
+    check_queries(data, a, pose_a, b, pose_b);
+  } catch (const std::exception& error) {
+    violated(error.what(), 0.0);  // no other exception is documented for valid shapes
+  }
+  return 0;
+}

@@ -1,0 +1,24 @@
+// The common region of two convex polygons of one plane, and its centre: what two parallel
+// polygons whose shadows overlap have as their set of closest points.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace diffpills::detail {
+
+struct HalfPlane {
+  Eigen::Vector2d normal;  // unit, outward: normal . y <= offset
+  double offset = 0.0;
+};
+
+// The centre of {y : normal . y <= offset + slack for every half-plane of both lists}, where each
+// list bounds a convex polygon: its area centroid, or, for a region thinner than a few `slack`
+// (polygons that only touch along an edge), the middle of its longest extent; the point itself
+// where the polygons touch at one. Returns false if the region is empty. O(n log n) in the total
+// number n of half-planes; allocates nothing for up to 34 per list. first_extent bounds the
+// distance of the first polygon's vertices from the origin.
+bool overlap_centre(const HalfPlane* first, Eigen::Index first_count, double first_extent,
+                    const HalfPlane* second, Eigen::Index second_count, double slack,
+                    Eigen::Vector2d& centre);
+
+}  // namespace diffpills::detail

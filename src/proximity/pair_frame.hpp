@@ -1,0 +1,29 @@
+// The frame every pair is solved in: lengths divided by a power of two near the scene's size.
+//
+// A query's inputs may be of any magnitude from 0 to 1e100 (and the whole scene may be scaled
+// anywhere in that range), but a solver that squares lengths, or compares squared distances,
+// over- or underflows at either end. So each query is solved in a frame where the scene's size
+// (the largest of the two core sizes, the two radii and the distance between the body origins) is
+// in [1, 2): every length is divided by scale = 2^e, and the body origin of shape a is moved to the
+// frame's origin. Dividing by a power of two is exact, so a scene scaled by 2^k is solved in
+// exactly the same normalized frame, bit for bit, and its results scale exactly: phi by 2^(2k),
+// points by 2^k, the gradient's position part by 2^k and its quaternion part by 2^(2k).
+#pragma once
+
+#include <Eigen/Core>
+
+namespace diffpills::detail {
+
+struct PairFrame {
+  double scale = 1.0;          // a length in the frame times scale is a length of the inputs
+  double inverse_scale = 1.0;  // 1 / scale, exact (also a power of two)
+  // Two distances (or heights) closer than this are taken as equal: the relative tie and
+  // intersection tolerance, 1e-12 of the scene's size, in the frame's units.
+  double tolerance = 0.0;
+};
+
+// size_* is a core's length scale (a capsule's length, a polygon's extent), radius_* its padding.
+PairFrame make_pair_frame(double size_a, double radius_a, double size_b, double radius_b,
+                          const Eigen::Vector3d& r_a, const Eigen::Vector3d& r_b);
+
+}  // namespace diffpills::detail

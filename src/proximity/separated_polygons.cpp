@@ -1,0 +1,227 @@
+#include "separated_polygons.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace diffpills::detail {
+
+PolygonPairFrame::PolygonPairFrame(const PosedCore& a, const PosedCore& b)
+    : b_in_a(a.attitude.matrix().transpose() * b.attitude.matrix()),
+      b_origin_in_a(a.attitude.matrix().transpose() * (b.r - a.r)),
+      a_origin_in_b(-b_in_a.transpose() * b_origin_in_a) {}
+
+namespace {
+
+Eigen::Vector3d lift(const Eigen::Vector2d& y) { return {y.x(), y.y(), 0.0}; }
+
+// What rules an edge pair out cheaply: two segments are at least |m1 - m2| - h1 - h2 apart (m the
+// midpoints, h the half-lengths), and an edge of B that does not cross A's plane is at least its
+// lower end's height above every point of A.
+struct EdgeBound {
+  Eigen::Vector3d middle;
+  double half_length = 0.0;
+  double height = 0.0;
+};
+
+EdgeBound edge_bound(const Segment& edge) {
+  const Eigen::Vector3d end = edge.start + edge.length * edge.direction;
+  const bool crosses = (edge.start.z() <= 0.0) != (end.z() <= 0.0) || edge.start.z() == 0.0;
+  return {0.5 * (edge.start + end), 0.5 * edge.length,
+          crosses ? 0.0 : std::min(std::abs(edge.start.z()), std::abs(end.z()))};
+}
+
+enum class Kind {
+  kEdges,         // edge i of A at s, edge j of B at t (s, t = 1: the edges' end vertices)
+  kBVertexOverA,  // vertex j of B over A's face
+  kAVertexOverB,  // vertex i of A over B's face
+  kBEdgeOverA,    // the point t of B's edge j over A's face (an interval's middle)
+  kAEdgeOverB,    // the point s of A's edge i over B's face (an interval's middle)
+};
+
+struct Candidate {
+  double distance2 = std::numeric_limits<double>::infinity();
+  Kind kind = Kind::kEdges;
+  Eigen::Index i = 0, j = 0;  // A's and B's feature
+  double s = 1.0, t = 1.0;    // edge parameters
+};
+
+// The best candidate and, apart, the best one standing for a whole interval of closest points.
+struct Best {
+  Candidate point, interval;
+  void offer(const Candidate& candidate, bool is_interval) {
+    Candidate& kept = is_interval ? interval : point;
+    if (candidate.distance2 < kept.distance2) kept = candidate;
+  }
+  // The interval wins a tie within the tolerance (see fast_paths.hpp).
+  const Candidate& choice(double tolerance) const {
+    const double reach = std::sqrt(point.distance2) + tolerance;
+    return interval.distance2 <= reach * reach ? interval : point;
+  }
+};
+
+// The vertex of `polygon` (carried into the other's frame, where the other lies in z = 0) that
+// could be a closest point over the other's face: the lowest if the polygon lies wholly above the
+// plane, the highest if wholly below. Only a support point in the direction of the plane can be
+// closest over its interior (the closest pair's difference is then along the plane's normal and
+// separates the two). Its neighbouring edges, if parallel to the plane (|sin| <= 1e-12) and over
+// the face, are the interval version. `over` is the polygon lying in z = 0.
+template <class Polygon, class Over>
+void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, bool polygon_is_b,
+                     double tolerance, Best& best) {
+  Eigen::Index lowest = 0, highest = 0;
+  for (Eigen::Index j = 1; j < polygon.size(); ++j) {
+    if (polygon[j].z() < polygon[lowest].z()) lowest = j;
+    if (polygon[j].z() > polygon[highest].z()) highest = j;
+  }
+  Eigen::Index support = 0;
+  if (polygon[lowest].z() > 0.0) {
+    support = lowest;
+  } else if (polygon[highest].z() < 0.0) {
+    support = highest;
+  } else {
+    return;  // the polygon meets the plane: no point over the face can be closest
+  }
+  const auto candidate = [&](Kind b_kind, Kind a_kind, Eigen::Index feature, double parameter,
+                             double height) {
+    Candidate c{height * height, polygon_is_b ? b_kind : a_kind, 0, 0, parameter, parameter};
+    (polygon_is_b ? c.j : c.i) = feature;
+    return c;
+  };
+  const Eigen::Vector3d& vertex = polygon[support];
+  if (contains(over, vertex.head<2>(), 0.0)) {
+    best.offer(candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z()),
+               false);
+  }
+  const Eigen::Index following = support + 1 == polygon.size() ? 0 : support + 1;
+  for (const Eigen::Index j : {support, following}) {  // the two edges at the support vertex
+    const Eigen::Vector3d& start = polygon.start(j);
+    const Eigen::Vector3d& end = polygon.end(j);
+    if (std::abs(end.z() - start.z()) > 1e-12 * (end - start).norm()) continue;
+    const auto [low, high] = clip_line(over, start.head<2>(), (end - start).head<2>(), tolerance);
+    if (low <= high) {
+      const double middle = 0.5 * (low + high);
+      const double height = start.z() + middle * (end.z() - start.z());
+      best.offer(candidate(Kind::kBEdgeOverA, Kind::kAEdgeOverB, j, middle, height), true);
+    }
+  }
+}
+
+// The two sides of an over-face candidate: `other`'s vertex, or the point of its edge, over the
+// face of the polygon in z = 0 of the frame `carried` is in. face_is_a: the face is shape a's.
+template <class Other>
+std::array<ClosestFeature, 2> over_face_sides(const Candidate& chosen, const Other& other,
+                                              const CarriedPolygon<Other>& carried,
+                                              bool face_is_a) {
+  const Eigen::Index feature = face_is_a ? chosen.j : chosen.i;
+  const double parameter = face_is_a ? chosen.t : chosen.s;
+  const Eigen::Vector3d point =
+      carried.start(feature) + parameter * (carried.end(feature) - carried.start(feature));
+  const ClosestFeature on_face = face_point(point.head<2>());
+  const ClosestFeature on_other = edge_point(other, feature, parameter);
+  if (face_is_a) return {on_face, on_other};
+  return {on_other, on_face};
+}
+
+// The two sides of a chosen candidate. A and B are PolygonView or SubPolygon, each with its
+// vertices carried into the other's frame (W: B's in A's frame, X: A's in B's).
+template <class Polygon>
+std::array<ClosestFeature, 2> sides(const Candidate& chosen, const Polygon& a, const Polygon& b,
+                                    const CarriedPolygon<Polygon>& W,
+                                    const CarriedPolygon<Polygon>& X) {
+  switch (chosen.kind) {
+    case Kind::kBVertexOverA:
+    case Kind::kBEdgeOverA:
+      return over_face_sides(chosen, b, W, true);
+    case Kind::kAVertexOverB:
+    case Kind::kAEdgeOverB:
+      return over_face_sides(chosen, a, X, false);
+    case Kind::kEdges:
+      break;
+  }
+  return {edge_point(a, chosen.i, chosen.s), edge_point(b, chosen.j, chosen.t)};
+}
+
+template <class Polygon>
+std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
+                                        const PolygonPairFrame& frame,
+                                        const CarriedPolygon<Polygon>& W,
+                                        const CarriedPolygon<Polygon>& X, double tolerance) {
+  const Eigen::Index ka = a.size();
+  const Eigen::Index kb = b.size();
+  Best best;
+  offer_over_face(W, a, true, tolerance, best);
+  offer_over_face(X, b, false, tolerance, best);
+  // The closest pair of vertices seeds the edge search with an achievable distance, so that the
+  // lower bounds below rule most edge pairs out from the start.
+  for (Eigen::Index i = 0; i < ka; ++i) {
+    const Eigen::Vector3d vertex = lift(a.vertex(i));
+    for (Eigen::Index j = 0; j < kb; ++j) {
+      best.offer({(vertex - W[j]).squaredNorm(), Kind::kEdges, i, j, 1.0, 1.0}, false);
+    }
+  }
+  // B's edges in A's frame, with the bounds that rule edge pairs out.
+  SmallBuffer<Segment> b_edges(kb);
+  SmallBuffer<EdgeBound> b_bounds(kb);
+  for (Eigen::Index j = 0; j < kb; ++j) {
+    const Segment edge = b.edge(j);
+    b_edges[j] = {W.start(j), frame.b_in_a * edge.direction, edge.length};
+    b_bounds[j] = edge_bound(b_edges[j]);
+  }
+  // Pairs are skipped only when a lower bound exceeds the best distance by the tolerance, so that
+  // an interval tying with the best point is still seen.
+  double reach = std::sqrt(best.point.distance2) + tolerance;
+  for (Eigen::Index i = 0; i < ka; ++i) {
+    const Segment edge = a.edge(i);
+    const EdgeBound a_bound = edge_bound(edge);
+    for (Eigen::Index j = 0; j < kb; ++j) {
+      const EdgeBound& b_bound = b_bounds[j];
+      // |m_a - m_b| - h_a - h_b >= reach  <=>  |m_a - m_b|^2 >= (reach + h_a + h_b)^2.
+      const double far = reach + a_bound.half_length + b_bound.half_length;
+      if (b_bound.height >= reach || (a_bound.middle - b_bound.middle).squaredNorm() >= far * far) {
+        continue;
+      }
+      const Segment& other = b_edges[j];
+      const SegmentParameters closest = closest_segment_parameters(edge, other);
+      const double distance2 = (edge.start + (closest.s * edge.length) * edge.direction -
+                                other.start - (closest.t * other.length) * other.direction)
+                                   .squaredNorm();
+      best.offer({distance2, Kind::kEdges, i, j, closest.s, closest.t}, closest.overlap);
+      reach = std::sqrt(best.point.distance2) + tolerance;
+    }
+  }
+
+  return sides(best.choice(tolerance), a, b, W, X);
+}
+
+}  // namespace
+
+std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const PolygonView& b,
+                                                const PolygonPairFrame& frame,
+                                                const CarriedPolygon<PolygonView>& W,
+                                                const CarriedPolygon<PolygonView>& X,
+                                                double tolerance) {
+  return enumerate(a, b, frame, W, X, tolerance);
+}
+
+std::array<ClosestFeature, 2> closest_separated(const SubPolygon& a, const SubPolygon& b,
+                                                const PolygonPairFrame& frame,
+                                                const CarriedPolygon<SubPolygon>& W,
+                                                const CarriedPolygon<SubPolygon>& X,
+                                                double tolerance) {
+  return enumerate(a, b, frame, W, X, tolerance);
+}
+
+bool closest_over_face(const PolygonView& face, const SubPolygon& other,
+                       const CarriedPolygon<SubPolygon>& carried, bool face_is_a, double tolerance,
+                       std::array<ClosestFeature, 2>& out) {
+  Best best;
+  offer_over_face(carried, face, face_is_a, tolerance, best);
+  const Candidate& chosen = best.choice(tolerance);
+  if (chosen.distance2 == std::numeric_limits<double>::infinity()) return false;
+  out = over_face_sides(chosen, other, carried, face_is_a);
+  return true;
+}
+
+}  // namespace diffpills::detail

@@ -1,0 +1,77 @@
+// The closest points of two polygons known not to intersect, by enumerating their features in
+// the first polygon's body frame: the enumeration behind polygon_polygon.cpp, on whole polygons
+// (PolygonView) or on windows of their vertices (SubPolygon, for polygon_windows.cpp).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+
+#include "polygon_features.hpp"
+#include "posed_core.hpp"
+#include "small_buffer.hpp"
+#include "sub_polygon.hpp"
+
+namespace diffpills::detail {
+
+// Polygon B's placement in polygon A's body frame, and A's in B's.
+struct PolygonPairFrame {
+  PolygonPairFrame(const PosedCore& a, const PosedCore& b);
+  Eigen::Matrix3d b_in_a;         // rotation from B's body frame to A's
+  Eigen::Vector3d b_origin_in_a;  // B's body origin in A's frame
+  Eigen::Vector3d a_origin_in_b;  // A's body origin in B's frame
+  // A point of A's frame in B's body x-y plane coordinates.
+  Eigen::Vector2d in_b(const Eigen::Vector3d& point_in_a) const {
+    return (b_in_a.transpose() * point_in_a + a_origin_in_b).head<2>();
+  }
+};
+
+// One polygon's vertices carried into the other's body frame, x -> rotation [x; 0] + translation.
+template <class Polygon>
+class CarriedPolygon {
+ public:
+  CarriedPolygon(const Polygon& polygon, const Eigen::Matrix3d& rotation,
+                 const Eigen::Vector3d& translation)
+      : count_(polygon.size()), vertices_(count_) {
+    for (Eigen::Index i = 0; i < count_; ++i) {
+      vertices_[i] = rotation.template leftCols<2>() * polygon.vertex(i) + translation;
+    }
+  }
+  const Eigen::Vector3d& operator[](Eigen::Index i) const { return vertices_[i]; }
+  // Start and end of edge j (edge j runs from vertex j - 1 to vertex j).
+  const Eigen::Vector3d& start(Eigen::Index j) const {
+    return vertices_[j == 0 ? count_ - 1 : j - 1];
+  }
+  const Eigen::Vector3d& end(Eigen::Index j) const { return vertices_[j]; }
+  Eigen::Index size() const { return count_; }
+
+ private:
+  Eigen::Index count_;
+  SmallBuffer<Eigen::Vector3d> vertices_;
+};
+
+// W: B's vertices carried into A's frame (frame.b_in_a), X: A's into B's. The candidates (see
+// polygon_polygon.cpp): a support vertex of one over the other's face (or, for an edge parallel to
+// that face, the middle of its part over it), and every pair of edges (the middle of their overlap
+// when parallel), the pairs whose lower bound exceeds the best distance by the tolerance skipped.
+// Candidates for a whole interval win ties within the tolerance.
+std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const PolygonView& b,
+                                                const PolygonPairFrame& frame,
+                                                const CarriedPolygon<PolygonView>& W,
+                                                const CarriedPolygon<PolygonView>& X,
+                                                double tolerance);
+std::array<ClosestFeature, 2> closest_separated(const SubPolygon& a, const SubPolygon& b,
+                                                const PolygonPairFrame& frame,
+                                                const CarriedPolygon<SubPolygon>& W,
+                                                const CarriedPolygon<SubPolygon>& X,
+                                                double tolerance);
+
+// When the face of one polygon is its whole support face (the closest points' difference is along
+// its normal), the closest pairs are the other's support vertex over that face, or the middle of
+// the part over it of a support edge parallel to it: the over-face candidates of the window
+// `other` (carried into the face's frame) against the whole face. face_is_a: the face is shape
+// a's. Returns false if no such candidate lies over the face (the pair is then on its boundary).
+bool closest_over_face(const PolygonView& face, const SubPolygon& other,
+                       const CarriedPolygon<SubPolygon>& carried, bool face_is_a, double tolerance,
+                       std::array<ClosestFeature, 2>& out);
+
+}  // namespace diffpills::detail

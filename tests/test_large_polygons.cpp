@@ -1,0 +1,219 @@
+// Polygons with many vertices: the window path (polygon_windows.hpp), which makes a pair cost about
+// linear in the vertex counts, must give the answer of the full enumeration it replaces above
+// 32 x 32 vertices, and of the brute-force reference. Both paths are called directly on the same
+// pairs; the public queries use the windows for these sizes.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "diffpills/diffpills.hpp"
+#include "proximity/polygon_windows.hpp"
+#include "proximity/separated_polygons.hpp"
+#include "support/random_shapes.hpp"
+#include "support/reference.hpp"
+#include "support/scene_helpers.hpp"
+
+namespace diffpills::testing {
+namespace {
+
+// A convex polygon of `count` vertices on a random ellipse (or a half-ellipse closed by one long
+// straight edge), with the body origin at a random interior point; its vertices in the body frame.
+TestShape many_sided(Rng& rng, int count, bool half) {
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double a = 0.5 + uniform(rng), b = 0.5 + uniform(rng), turn = M_PI * uniform(rng);
+  const Eigen::Matrix2d rotation = Eigen::Rotation2Dd(turn).toRotationMatrix();
+  std::vector<Eigen::Vector2d> points;
+  const double span = half ? M_PI : 2.0 * M_PI;
+  for (int i = 0; i < count; ++i) {
+    const double angle = span * (i + 0.3 * uniform(rng)) / (half ? count - 1 : count);
+    points.push_back(rotation * Eigen::Vector2d(a * std::cos(angle), b * std::sin(angle)));
+  }
+  if (half) points.back() = rotation * Eigen::Vector2d(-a, 0.0);
+  const Eigen::Vector2d centre = 0.3 * (points[0] + points[count / 3] + points[2 * count / 3]);
+  Eigen::MatrixX2d C(count, 2);
+  Eigen::VectorXd d(count);
+  TestShape out{Capsule(0, 0), {}, 0.0};
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector2d p = points[i] - centre, q = points[(i + 1) % count] - centre;
+    const Eigen::Vector2d normal = Eigen::Vector2d(q.y() - p.y(), p.x() - q.x()).normalized();
+    C.row(i) = normal.transpose();
+    d(i) = normal.dot(p);
+    out.body_vertices.emplace_back(p.x(), p.y(), 0.0);
+    out.size = std::max(out.size, p.norm());
+  }
+  out.shape = PaddedPolygon(C, d, 0.05);
+  return out;
+}
+
+using Sides = std::array<detail::ClosestFeature, 2>;
+
+struct BothPaths {
+  Sides windows, enumeration;
+  detail::PosedCore a, b;
+};
+
+// Both separated-pair solvers on one pair, in a frame of scale 1 (the inputs are of order one).
+BothPaths both_paths(const PaddedPolygon& a, const Pose& pa, const PaddedPolygon& b,
+                     const Pose& pb) {
+  const detail::PolygonView view_a(a, 1.0), view_b(b, 1.0);
+  BothPaths out{{},
+                {},
+                {pa.r(), detail::UnitQuaternion(pa.q()), 0.0, a.extent()},
+                {pb.r(), detail::UnitQuaternion(pb.q()), 0.0, b.extent()}};
+  const double tolerance = 1e-12 * std::max({a.extent(), b.extent(), (pb.r() - pa.r()).norm()});
+  const detail::PolygonPairFrame frame(out.a, out.b);
+  const detail::CarriedPolygon<detail::PolygonView> W(view_b, frame.b_in_a, frame.b_origin_in_a);
+  const detail::CarriedPolygon<detail::PolygonView> X(view_a, frame.b_in_a.transpose(),
+                                                      frame.a_origin_in_b);
+  out.windows = detail::closest_separated_by_windows(view_a, view_b, frame, W, tolerance);
+  out.enumeration = detail::closest_separated(view_a, view_b, frame, W, X, tolerance);
+  return out;
+}
+
+Eigen::Vector3d world(const detail::PosedCore& core, const detail::ClosestFeature& side) {
+  return core.r + core.attitude.matrix() * side.body_point;
+}
+
+TEST(LargePolygons, WindowsAgreeWithEnumerationAndBruteForce) {
+  Rng rng(17);
+  int separated = 0;
+  for (int i = 0; i < 300; ++i) {
+    const int ka = std::uniform_int_distribution<int>(33, 160)(rng);
+    const int kb = std::uniform_int_distribution<int>(33, 160)(rng);
+    const TestShape a = many_sided(rng, ka, i % 5 == 0), b = many_sided(rng, kb, i % 7 == 0);
+    const Pose pa = random_pose(rng, 1.0), pb = random_pose(rng, 2.5);
+    const auto& polygon_a = std::get<PaddedPolygon>(a.shape);
+    const auto& polygon_b = std::get<PaddedPolygon>(b.shape);
+    const ClosestPair reference = brute_force_closest(to_world(a, pa), to_world(b, pb));
+    if (reference.distance < 1e-6) continue;  // the windows are for separated pairs
+    ++separated;
+    const BothPaths paths = both_paths(polygon_a, pa, polygon_b, pb);
+    const Eigen::Vector3d w1 = world(paths.a, paths.windows[0]);
+    const Eigen::Vector3d w2 = world(paths.b, paths.windows[1]);
+    const Eigen::Vector3d e1 = world(paths.a, paths.enumeration[0]);
+    const Eigen::Vector3d e2 = world(paths.b, paths.enumeration[1]);
+    ASSERT_NEAR((w1 - w2).norm(), static_cast<double>(reference.distance), 1e-12) << i;
+    ASSERT_LE((w1 - e1).norm(), 1e-9) << i;
+    ASSERT_LE((w2 - e2).norm(), 1e-9) << i;
+    ASSERT_EQ(paths.windows[0].free_dimensions, paths.enumeration[0].free_dimensions) << i;
+    ASSERT_EQ(paths.windows[1].free_dimensions, paths.enumeration[1].free_dimensions) << i;
+    // The public query (windows at these sizes) against the reference, with its gradient.
+    const Proximity result = proximity(polygon_a, pa, polygon_b, pb);
+    ASSERT_LE((result.core_points[0] - w1).norm(), 1e-9) << i;
+  }
+  EXPECT_GT(separated, 200);
+}
+
+// Ties at large sizes: the half-ellipse's straight edge parallel to a square's edge, beside it
+// and above it, and a vertex or an edge of one over the face of a 2000-gon.
+TEST(LargePolygons, TiesAndFacesMatchTheEnumeration) {
+  Rng rng(18);
+  for (int i = 0; i < 60; ++i) {
+    const TestShape half = many_sided(rng, 200, true);
+    const auto& polygon = std::get<PaddedPolygon>(half.shape);
+    // The straight edge closes the polygon, from the last body vertex to the first.
+    const Eigen::Vector3d start = half.body_vertices[199], end = half.body_vertices[0];
+    const Eigen::Vector3d along = (end - start).normalized();
+    const Eigen::Vector3d outward(along.y(), -along.x(), 0.0);
+    // A 64-gon square-ish polygon whose edge faces the straight edge: a regular 64-gon rotated so
+    // that one edge is parallel to it, 0.3 away, sideways by a random amount, raised by h.
+    const int sides = 64;
+    Eigen::MatrixX2d C(sides, 2);
+    for (int k = 0; k < sides; ++k) {
+      C.row(k) << std::cos(2 * M_PI * k / sides), std::sin(2 * M_PI * k / sides);
+    }
+    const PaddedPolygon round(C, Eigen::VectorXd::Constant(sides, 0.2), 0.0);
+    const double angle = std::atan2(-outward.y(), -outward.x());  // row 0 faces the edge
+    const double h = (i % 3) * 0.1;
+    const Eigen::Vector3d centre = 0.5 * (start + end) + outward * 0.5 +
+                                   along * std::uniform_real_distribution<double>(-0.3, 0.3)(rng) +
+                                   Eigen::Vector3d(0, 0, h);
+    const Pose pa({0, 0, 0}, kIdentity), pb(centre, about(angle, 0, 0, 1));
+    const BothPaths paths = both_paths(polygon, pa, round, pb);
+    // The middle of the overlap is the midpoint of the 64-gon's short facing edge.
+    const Eigen::Vector3d midpoint = centre - 0.2 * outward;
+    ASSERT_LE((world(paths.b, paths.windows[1]) - midpoint).norm(), 1e-9) << i;
+    ASSERT_LE(
+        (world(paths.a, paths.windows[0]) - (midpoint - 0.3 * outward - Eigen::Vector3d(0, 0, h)))
+            .norm(),
+        1e-9)
+        << i;
+    for (int side = 0; side < 2; ++side) {
+      const detail::PosedCore& core = side == 0 ? paths.a : paths.b;
+      ASSERT_LE((world(core, paths.windows[side]) - world(core, paths.enumeration[side])).norm(),
+                1e-9)
+          << i;
+    }
+  }
+  // A square hovering over a 2000-gon: a vertex over its face, then an edge parallel to it.
+  Eigen::MatrixX2d C(2000, 2);
+  for (int k = 0; k < 2000; ++k)
+    C.row(k) << std::cos(2 * M_PI * k / 2000), std::sin(2 * M_PI * k / 2000);
+  const PaddedPolygon disc(C, Eigen::VectorXd::Constant(2000, 1.0), 0.0);
+  const PaddedPolygon small = square(0.25, 0.0);
+  const Pose corner_down({0.2, 0.1, 0.6}, about(0.7, 1, 1, 0));
+  const Pose edge_down({0.9, 0.1, 0.4}, about(M_PI / 4, 0, 1, 0));
+  for (const Pose& pose : {corner_down, edge_down}) {
+    for (const bool disc_first : {true, false}) {
+      const BothPaths paths = disc_first ? both_paths(disc, Pose(), small, pose)
+                                         : both_paths(small, pose, disc, Pose());
+      for (int side = 0; side < 2; ++side) {
+        const detail::PosedCore& core = side == 0 ? paths.a : paths.b;
+        ASSERT_LE((world(core, paths.windows[side]) - world(core, paths.enumeration[side])).norm(),
+                  1e-9);
+      }
+    }
+  }
+  // The edge x = 0.9 + 0.25/sqrt(2) .. hangs over the disc's rim: the middle of its part over the
+  // disc, against the public query in both orders.
+  const Proximity over = proximity(small, edge_down, disc, Pose());
+  const Proximity under = proximity(disc, Pose(), small, edge_down);
+  EXPECT_LE((over.core_points[0] - under.core_points[1]).norm(), 1e-9);
+  EXPECT_NEAR(over.core_points[1].z(), 0.0, 1e-12);
+}
+
+// 10^5-gons: analytic answers. Two coplanar regular polygons side by side (apothem 1, centres
+// 2.5 apart: edge midpoints 0.5 apart), a sphere above the face and beside the rim.
+TEST(LargePolygons, HundredThousandGons) {
+  const int count = 100000;
+  Eigen::MatrixX2d C(count, 2);
+  for (int k = 0; k < count; ++k)
+    C.row(k) << std::cos(2 * M_PI * k / count), std::sin(2 * M_PI * k / count);
+  const PaddedPolygon disc(C, Eigen::VectorXd::Constant(count, 1.0), 0.1);
+  ASSERT_EQ(disc.vertices().rows(), count);
+  const Proximity side = proximity(disc, Pose(), disc, Pose({2.5, 0, 0}, kIdentity));
+  EXPECT_NEAR(side.phi, 0.25 - 0.04, 1e-12);
+  const Proximity tilted =
+      proximity(disc, Pose(), disc, Pose({2.5, 0, 0}, about(0.3, 1, 0, 0)));  // rim to rim
+  EXPECT_NEAR(tilted.phi, 0.25 - 0.04, 1e-9);
+  const Proximity above = proximity(Capsule(0, 0), Pose({0.2, 0.3, 2}, kIdentity), disc, Pose());
+  EXPECT_NEAR(above.phi, 4.0 - 0.01, 1e-12);
+}
+
+// Polygons far smaller than the distance between them (found by fuzz_proximity): in the pair's
+// frame their vertices are of order 1e-200, whose squares underflow, and a window's chords must
+// still bound it. The closest points lie on the two polygons, whichever comes first.
+TEST(LargePolygons, PolygonsFarSmallerThanTheirDistance) {
+  const auto regular = [](int count, double apothem) {
+    Eigen::MatrixX2d C(count, 2);
+    for (int k = 0; k < count; ++k)
+      C.row(k) << std::cos(2 * M_PI * k / count), std::sin(2 * M_PI * k / count);
+    return PaddedPolygon(C, Eigen::VectorXd::Constant(count, apothem), 0.0);
+  };
+  const PaddedPolygon large = regular(293, 4e4), speck = regular(293, 5e-115);
+  const Pose at_origin(Eigen::Vector3d::Zero(), Eigen::Vector4d(0.3, 0.3, 0.3, 0.3001));
+  const Pose far(Eigen::Vector3d(2, -6e87, 3e-115), kIdentity);
+  const Proximity ab = proximity(large, at_origin, speck, far);
+  const Proximity ba = proximity(speck, far, large, at_origin);
+  EXPECT_LE((ab.core_points[0]).norm(), 1.01 * large.extent());
+  EXPECT_LE((ab.core_points[1] - far.r()).norm(), 1e-100);
+  EXPECT_EQ(ab.core_points[0], ba.core_points[1]);
+  EXPECT_EQ(ab.core_points[1], ba.core_points[0]);
+  EXPECT_DOUBLE_EQ(ab.phi, 3.6e175);
+  EXPECT_EQ(ab.phi, ba.phi);
+}
+
+}  // namespace
+}  // namespace diffpills::testing

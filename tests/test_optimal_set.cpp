@@ -1,0 +1,147 @@
+// Where the closest points are not unique, every pair type returns the middle of the optimal set
+// (the midpoint of an interval, the centroid of a planar region), so that the answer depends
+// neither on which shape comes first nor on a rigid motion of the whole scene. Each configuration
+// is checked against its analytic middle, with the shapes swapped, and under random rigid motions
+// of both shapes together (points moved, normal and position gradients rotated, quaternion
+// gradients mapped by L(m) for the motion's quaternion m, all to 1e-9 of the scene's size).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "diffpills/diffpills.hpp"
+#include "support/scene_helpers.hpp"
+
+namespace diffpills::testing {
+namespace {
+
+using Vector14 = Eigen::Matrix<double, 14, 1>;
+
+// The swapped query's gradient in the original layout.
+Vector14 swap_halves(const Vector14& g) {
+  Vector14 out;
+  out << g.tail<7>(), g.head<7>();
+  return out;
+}
+
+template <class A, class B>
+void expect_middle(const A& a, const Pose& pa, const B& b, const Pose& pb,
+                   const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double size = 1.0) {
+  const ProximityJacobian r = proximity_jacobian(a, pa, b, pb);
+  EXPECT_LE((r.core_points[0] - p1).norm(), 1e-12 * size) << r.core_points[0].transpose();
+  EXPECT_LE((r.core_points[1] - p2).norm(), 1e-12 * size) << r.core_points[1].transpose();
+  ASSERT_TRUE(r.gradient.allFinite() && r.points_jacobian.allFinite());
+
+  const ProximityJacobian swapped = proximity_jacobian(b, pb, a, pa);
+  EXPECT_LE((swapped.core_points[0] - r.core_points[1]).norm(), 1e-9 * size);
+  EXPECT_LE((swapped.core_points[1] - r.core_points[0]).norm(), 1e-9 * size);
+  EXPECT_LE((swap_halves(swapped.gradient) - r.gradient).norm(), 1e-9 * size * size);
+
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal;
+  for (int i = 0; i < 25; ++i) {
+    const Eigen::Quaterniond m =
+        Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+    const Eigen::Matrix3d R = m.toRotationMatrix();
+    const Eigen::Vector3d t = 3.0 * size * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    const auto moved = [&](const Pose& pose) {
+      const Eigen::Quaterniond q =
+          m * Eigen::Quaterniond(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
+      return Pose(R * pose.r() + t, Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()));
+    };
+    const Eigen::Matrix4d L = left_multiply_matrix(Eigen::Vector4d(m.w(), m.x(), m.y(), m.z()));
+    for (const bool swap : {false, true}) {
+      const ProximityJacobian after = swap ? proximity_jacobian(b, moved(pb), a, moved(pa))
+                                           : proximity_jacobian(a, moved(pa), b, moved(pb));
+      const int first = swap ? 1 : 0;
+      EXPECT_LE((after.core_points[first] - (R * r.core_points[0] + t)).norm(), 1e-9 * size);
+      EXPECT_LE((after.core_points[1 - first] - (R * r.core_points[1] + t)).norm(), 1e-9 * size);
+      const Vector14 g = swap ? swap_halves(after.gradient) : after.gradient;
+      for (const int block : {0, 7}) {
+        EXPECT_LE((g.segment<3>(block) - R * r.gradient.segment<3>(block)).norm(), 1e-9 * size);
+        EXPECT_LE((g.segment<4>(block + 3) - L * r.gradient.segment<4>(block + 3)).norm(),
+                  1e-9 * size * size);
+      }
+    }
+  }
+}
+
+const Eigen::Vector4d kQuarterX = about(M_PI / 2, 1, 0, 0);  // the body x-y plane to x-z
+const Eigen::Vector4d kQuarterY = about(M_PI / 2, 0, 1, 0);  // the body x-y plane to y-z
+
+// A capsule of length 1 beside the unit square's edge y = 1/2: the overlap of the two, in the
+// plane and above it.
+TEST(OptimalSet, CapsuleBesideASquaresEdge) {
+  const Capsule capsule(1.0, 0.1);
+  const PaddedPolygon plate = square(0.5, 0.05);
+  expect_middle(capsule, Pose({0, 0.8, 0}, kIdentity), plate, Pose(), {0, 0.8, 0}, {0, 0.5, 0});
+  expect_middle(capsule, Pose({0.7, 0.8, 0}, kIdentity), plate, Pose(), {0.35, 0.8, 0},
+                {0.35, 0.5, 0});
+  expect_middle(capsule, Pose({0.7, 0.8, 0.3}, kIdentity), plate, Pose(), {0.35, 0.8, 0.3},
+                {0.35, 0.5, 0});
+  // The square turned by a quarter: the same edge is another row.
+  expect_middle(capsule, Pose({0.7, 0.8, 0}, kIdentity), plate,
+                Pose({0, 0, 0}, about(M_PI / 2, 0, 0, 1)), {0.35, 0.8, 0}, {0.35, 0.5, 0});
+}
+
+// A capsule parallel to the plane, half over the face: the middle of its part over the face.
+TEST(OptimalSet, CapsuleHalfOverAFace) {
+  expect_middle(Capsule(1.0, 0.1), Pose({0.7, 0.1, 0.4}, kIdentity), square(0.5, 0.05), Pose(),
+                {0.35, 0.1, 0.4}, {0.35, 0.1, 0});
+  // In the plane, through the edge: the cores meet along x in [0.2, 0.5].
+  expect_middle(Capsule(1.0, 0.1), Pose({0.7, 0.1, 0}, kIdentity), square(0.5, 0.05), Pose(),
+                {0.35, 0.1, 0}, {0.35, 0.1, 0});
+}
+
+// Two coplanar squares side by side: the facing edges x = 0.5 and x = 0.6 overlap for y in
+// [0.15, 0.5]; with the second square raised, the same interval.
+TEST(OptimalSet, SquaresSideBySide) {
+  const PaddedPolygon big = square(0.5, 0.05), small = square(0.25, 0.05);
+  expect_middle(big, Pose(), small, Pose({0.85, 0.4, 0}, kIdentity), {0.5, 0.325, 0},
+                {0.6, 0.325, 0});
+  expect_middle(big, Pose(), small, Pose({0.85, 0.4, 0}, about(M_PI / 2, 0, 0, 1)), {0.5, 0.325, 0},
+                {0.6, 0.325, 0});
+  expect_middle(big, Pose(), small, Pose({0.85, 0.4, 0.3}, kIdentity), {0.5, 0.325, 0},
+                {0.6, 0.325, 0.3});
+  // Touching along the overlap (no gap): the cores meet on the interval.
+  expect_middle(big, Pose(), small, Pose({0.75, 0.4, 0}, kIdentity), {0.5, 0.325, 0},
+                {0.5, 0.325, 0});
+}
+
+// A box face (a square in a vertical plane) standing on a table: its bottom edge x in [-0.4, 0.6]
+// meets the table x in [-0.5, 0.5]; raised by 0.1 it hovers over the same interval; a wider box
+// hangs over both sides of the table.
+TEST(OptimalSet, BoxEdgeOnATable) {
+  const PaddedPolygon table = square(0.5, 0.0), face = square(0.5, 0.0);
+  expect_middle(face, Pose({0.1, 0, 0.5}, kQuarterX), table, Pose(), {0.05, 0, 0}, {0.05, 0, 0});
+  expect_middle(face, Pose({0.1, 0, 0.6}, kQuarterX), table, Pose(), {0.05, 0, 0.1}, {0.05, 0, 0});
+  expect_middle(square(1.0, 0.0), Pose({0, 0.2, 1.1}, kQuarterX), table, Pose(), {0, 0.2, 0.1},
+                {0, 0.2, 0});
+  expect_middle(square(1.0, 0.0), Pose({0, 0.2, 1.0}, kQuarterX), table, Pose(), {0, 0.2, 0},
+                {0, 0.2, 0});
+}
+
+// A square's edge x = 0.5 beside a vertical square in the plane x = 1 (y in [-0.3, 0.7]): the
+// edge's part facing the other's face, y in [-0.3, 0.5].
+TEST(OptimalSet, EdgeFacingAFace) {
+  expect_middle(square(0.5, 0.0), Pose(), square(0.5, 0.0), Pose({1.0, 0.2, 0}, kQuarterY),
+                {0.5, 0.1, 0}, {1.0, 0.1, 0});
+}
+
+// Two parallel segments, and a segment along a polygon's edge line outside it.
+TEST(OptimalSet, ParallelSegments) {
+  expect_middle(Capsule(2.0, 0.1), Pose(), Capsule(2.0, 0.1), Pose({0.5, 0, 1}, kIdentity),
+                {0.25, 0, 0}, {0.25, 0, 1});
+  expect_middle(Capsule(2.0, 0.1), Pose(), Capsule(1.0, 0.1),
+                Pose({0.5, 0.3, 0.4}, about(M_PI, 0, 0, 1)), {0.5, 0, 0}, {0.5, 0.3, 0.4});
+}
+
+// Stacked parallel squares: the centroid of the overlap of their shadows.
+TEST(OptimalSet, StackedSquares) {
+  expect_middle(square(0.5, 0.0), Pose(), square(0.25, 0.0), Pose({0.6, 0.5, 0.3}, kIdentity),
+                {0.425, 0.375, 0}, {0.425, 0.375, 0.3});
+}
+
+}  // namespace
+}  // namespace diffpills::testing
