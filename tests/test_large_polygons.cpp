@@ -196,13 +196,13 @@ TEST(LargePolygons, HundredThousandGons) {
 // frame their vertices are of order 1e-200, whose squares underflow, and a window's chords must
 // still bound it. The closest points lie on the two polygons, whichever comes first.
 TEST(LargePolygons, PolygonsFarSmallerThanTheirDistance) {
-  const auto regular = [](int count, double apothem) {
+  const auto regular = [](int count, double apothem, double radius) {
     Eigen::MatrixX2d C(count, 2);
     for (int k = 0; k < count; ++k)
       C.row(k) << std::cos(2 * M_PI * k / count), std::sin(2 * M_PI * k / count);
-    return PaddedPolygon(C, Eigen::VectorXd::Constant(count, apothem), 0.0);
+    return PaddedPolygon(C, Eigen::VectorXd::Constant(count, apothem), radius);
   };
-  const PaddedPolygon large = regular(293, 4e4), speck = regular(293, 5e-115);
+  const PaddedPolygon large = regular(293, 4e4, 0.0), speck = regular(293, 5e-115, 0.0);
   const Pose at_origin(Eigen::Vector3d::Zero(), Eigen::Vector4d(0.3, 0.3, 0.3, 0.3001));
   const Pose far(Eigen::Vector3d(2, -6e87, 3e-115), kIdentity);
   const Proximity ab = proximity(large, at_origin, speck, far);
@@ -213,6 +213,50 @@ TEST(LargePolygons, PolygonsFarSmallerThanTheirDistance) {
   EXPECT_EQ(ab.core_points[1], ba.core_points[0]);
   EXPECT_DOUBLE_EQ(ab.phi, 3.6e175);
   EXPECT_EQ(ab.phi, ba.phi);
+
+  // Two polygons whose vertices all underflow to their origins in the frame, one origin in the
+  // other's plane: a window of three coincident vertices would be an unbounded wedge.
+  const PaddedPolygon a = regular(461, 5.2e-311, 0.25), b = regular(293, 2.2e-308, 0.0);
+  const Pose pa(Eigen::Vector3d(-4.2e78, 3.1e-115, 9e-188), about(M_PI / 2, 1, 0, 0));
+  const Pose pb(Eigen::Vector3d(1.5, 3.05e-115, 3), about(M_PI, 1, 0, 0));
+  for (const Method method : {Method::kDefault, Method::kInteriorPoint}) {
+    const Proximity apart = proximity(a, pa, b, pb, {method});
+    EXPECT_EQ(apart.core_points[0], pa.r());
+    EXPECT_EQ(apart.core_points[1], pb.r());
+    EXPECT_DOUBLE_EQ(apart.phi, (pa.r() - pb.r()).squaredNorm() - 0.0625);
+    EXPECT_FALSE(apart.cores_intersect);
+  }
+}
+
+// A small polygon lying in a large one's plane, 1e-11 rad from parallel (beyond the 1e-12 that
+// counts as parallel): the cores intersect in both orders (found by fuzz_proximity, where the
+// large polygon's vertices within the tolerance of the small one's plane skewed the section).
+TEST(LargePolygons, NearlyCoplanarOverlapIsAnIntersection) {
+  const auto regular = [](int count, double apothem) {
+    Eigen::MatrixX2d C(count, 2);
+    for (int k = 0; k < count; ++k)
+      C.row(k) << std::cos(2 * M_PI * k / count), std::sin(2 * M_PI * k / count);
+    return PaddedPolygon(C, Eigen::VectorXd::Constant(count, apothem), 0.01);
+  };
+  for (const auto& [ka, kb] : {std::pair{151, 121}, std::pair{12, 12}}) {
+    const PaddedPolygon large = regular(ka, 41402.0), small = regular(kb, 2.75);
+    const Pose pose_large({1.75, 0, 1.625}, about(M_PI / 2, 1, 0, 0));
+    const Pose pose_small({0.5, 0, 0}, about(M_PI / 2 + 1e-11, 1, 0, 0));
+    const Proximity ab = proximity(large, pose_large, small, pose_small);
+    const Proximity ba = proximity(small, pose_small, large, pose_large);
+    EXPECT_TRUE(ab.cores_intersect) << ka;
+    EXPECT_TRUE(ba.cores_intersect) << ka;
+    EXPECT_NEAR(ab.phi, -0.0004, 1e-12);
+    EXPECT_NEAR(ba.phi, -0.0004, 1e-12);
+    // The planes cross along world x through the small polygon's centre; the intersection is
+    // that chord of the small polygon, from its edge at +x (apothem 2.75) to, for an odd count,
+    // the vertex at -x (circumradius 2.75 / cos(pi / kb)); its middle is returned. Heights
+    // rounded to eps * 2.75 place the line of planes 1e-11 from parallel only to
+    // 2.75e-16 / 1e-11 ~ 3e-5 across the small polygon, which moves the chord's ends about as much.
+    const double far_end = kb % 2 == 1 ? 2.75 / std::cos(M_PI / kb) : 2.75;
+    EXPECT_NEAR(ab.core_points[1].x(), 0.5 + 0.5 * (2.75 - far_end), 1e-4);
+    EXPECT_LE((ab.core_points[1] - ba.core_points[0]).norm(), 1e-9 * 41402.0);
+  }
 }
 
 }  // namespace

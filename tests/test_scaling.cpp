@@ -239,6 +239,15 @@ TEST(Scaling, PolygonBelowTheFramesResolution) {
     EXPECT_TRUE(result.gradient.allFinite());
     EXPECT_EQ(result.core_points[0], far.r());
   }
+  // A capsule whose length is subnormal beside a sphere (found by fuzz_proximity: the reference
+  // QP divided by that length).
+  const Capsule needle(2.6e-314, 41402.0), sphere(0.0, 1e-115);
+  const Pose near(Eigen::Vector3d(0.5, 3e-115, 3e-115), kIdentity);
+  for (const Method method : {Method::kDefault, Method::kInteriorPoint}) {
+    const Proximity result = proximity(needle, near, sphere, Pose(), {method});
+    EXPECT_DOUBLE_EQ(result.phi, 0.25 - 41402.0 * 41402.0);
+    EXPECT_EQ(result.core_points[0], near.r());
+  }
 }
 
 }  // namespace

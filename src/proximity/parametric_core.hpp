@@ -28,7 +28,8 @@ struct ParametricCore {
   double size = 0.0;  // length scale: the capsule's length or the polygon's extent
 };
 
-// A capsule of the given length (a sphere for 0), and a polygon.
+// A capsule of the given length (a sphere for 0), and a polygon. A core smaller than 2^-500 of the
+// frame's unit (3e-151 of the scene's size) is the point at its body origin (see the source).
 ParametricCore make_parametric_capsule(double length);
 ParametricCore make_parametric_polygon(const PolygonView& polygon);
 

@@ -37,9 +37,19 @@ bool parallel_overlap(const PolygonView& a, const PolygonView& b, const PolygonP
 // The segment S = B /\ {z = 0} of crossing planes (in A's frame): its ends are the extreme points,
 // along the planes' common line, of B's vertices in the plane (within the tolerance) and of the
 // crossings of B's edges. Returns false if B does not reach the plane.
+//
+// A vertex of B counts as in the plane only if it is also within the tolerance of the common
+// line: B's plane meets z = 0 at an angle delta, and a vertex at height z lies |z| cos(delta) /
+// sin(delta) from the line, along A's plane. For planes a few 1e-12 from parallel the band
+// |z| <= tolerance is as wide as the polygons, and its vertices would make S a skewed chord that
+// misses the true intersection (found by fuzz_proximity).
 bool plane_section(const CarriedPolygon<PolygonView>& W, const Eigen::Vector3d& b_normal,
                    double tolerance, Eigen::Vector2d& start, Eigen::Vector2d& end) {
   const Eigen::Vector3d line = Eigen::Vector3d::UnitZ().cross(b_normal);
+  const double sin_delta = b_normal.head<2>().norm(), cos_delta = std::abs(b_normal.z());
+  const auto in_plane = [&](double z) {
+    return std::abs(z) <= tolerance && std::abs(z) * cos_delta <= tolerance * sin_delta;
+  };
   double low = std::numeric_limits<double>::infinity(), high = -low;
   const auto add = [&](const Eigen::Vector3d& point) {
     const double along = line.dot(point);
@@ -49,7 +59,7 @@ bool plane_section(const CarriedPolygon<PolygonView>& W, const Eigen::Vector3d& 
   for (Eigen::Index j = 0; j < W.size(); ++j) {
     const Eigen::Vector3d& s = W.start(j);
     const Eigen::Vector3d& e = W.end(j);
-    if (std::abs(e.z()) <= tolerance) add(lift(e.head<2>()));
+    if (in_plane(e.z())) add(lift(e.head<2>()));
     if ((s.z() < 0.0 && e.z() > 0.0) || (s.z() > 0.0 && e.z() < 0.0)) {
       add(s + (s.z() / (s.z() - e.z())) * (e - s));
     }

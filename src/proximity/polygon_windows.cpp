@@ -129,8 +129,13 @@ std::array<ClosestFeature, 2> closest_separated_by_windows(const PolygonView& a,
     const double margin = 2.0 * tolerance * d.norm();
     top_a = climb(top_a, a.size(), along_a);
     bottom_b = climb(bottom_b, b.size(), against_b);
-    const Arc arc_a = arc_around(top_a, a.size(), margin, along_a);
-    const Arc arc_b = arc_around(bottom_b, b.size(), margin, against_b);
+    // A polygon whose extent is within the margin (a speck, far smaller than the scene) is taken
+    // whole: a window of it would have chords between vertices that its few resolved digits, or
+    // underflow, can make coincide, and a chord of no length bounds nothing.
+    const Arc arc_a = a.extent() <= margin ? Arc{0, a.size(), false}
+                                           : arc_around(top_a, a.size(), margin, along_a);
+    const Arc arc_b = b.extent() <= margin ? Arc{0, b.size(), false}
+                                           : arc_around(bottom_b, b.size(), margin, against_b);
     // A whole polygon within the margin is a face facing the other along its normal: its windows
     // keep only the support (enough for the certificate), and once the other side's arc is in
     // its window the answer is the other's support over that whole face.

@@ -9,7 +9,8 @@ namespace diffpills::detail {
 // component before it is normalized: a polygon far smaller than the scene has vertices of order
 // 1e-200 in the frame's units, whose squares underflow (Eigen's normalized() then returns the
 // vector unchanged, and the row would hold every point). A chord between vertices that coincide
-// in the frame gets the zero row 0 . y <= 0, which constrains nothing.
+// in the frame gets the zero row 0 . y <= 0, which constrains nothing; polygon_windows.cpp takes
+// a polygon that small whole, so that its windows have no such chord.
 SubPolygon::SubPolygon(const PolygonView& full, std::vector<Eigen::Index> indices)
     : full_(&full), indices_(std::move(indices)) {
   normals_.resize(indices_.size());
