@@ -4,8 +4,10 @@
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <new>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -60,15 +62,19 @@ void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
   // chunk per thread left one thread idle while the other finished (1.79x on two threads instead
   // of 1.8-1.9x). Each row is written by exactly one thread; nothing else is shared.
   constexpr Eigen::Index kBlock = 512;
-  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
   const Eigen::Index blocks = (n + kBlock - 1) / kBlock;
-  const Eigen::Index threads = std::min<Eigen::Index>(
-      std::max<Eigen::Index>(blocks, 1), options.threads == 0 ? hardware : options.threads);
+  // Threads beyond the hardware's only take turns, and threads beyond the blocks find no work, so
+  // a request above either is capped: threads = 10^6 starts no more threads than threads = 0.
+  const Eigen::Index hardware = std::max(1u, std::thread::hardware_concurrency());
+  const Eigen::Index requested = options.threads == 0 ? hardware : options.threads;
+  const Eigen::Index threads = std::max<Eigen::Index>(1, std::min({requested, hardware, blocks}));
   std::atomic<Eigen::Index> next_block{0};
   std::exception_ptr first_error;
   std::atomic<Eigen::Index> first_error_row{n};
   std::mutex error_mutex;
-  const auto work = [&] {
+  // Every exception of a row is caught here and carried to the caller: one escaping a thread's
+  // function would end the process with std::terminate.
+  const auto work = [&]() noexcept {
     for (Eigen::Index block = next_block++; block < blocks; block = next_block++) {
       const Eigen::Index begin = block * kBlock;
       const Eigen::Index end = std::min(n, begin + kBlock);
@@ -92,14 +98,23 @@ void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
       }
     }
   };
-  if (threads <= 1) {
-    work();
-  } else {
-    std::vector<std::thread> pool;
-    pool.reserve(static_cast<std::size_t>(threads));
-    for (Eigen::Index t = 0; t < threads; ++t) pool.emplace_back(work);
-    for (std::thread& thread : pool) thread.join();
+  // The calling thread works beside threads - 1 helpers. A helper the system refuses (no thread
+  // or no memory for its stack left) is not an error: the rows do not depend on which thread
+  // computes them, so the batch goes on with the helpers that did start, or with the caller
+  // alone. work() throws nothing, so every started helper is joined before this returns.
+  std::vector<std::thread> helpers;
+  helpers.reserve(static_cast<std::size_t>(threads - 1));
+  for (Eigen::Index t = 1; t < threads; ++t) {
+    try {
+      helpers.emplace_back(work);
+    } catch (const std::system_error&) {
+      break;
+    } catch (const std::bad_alloc&) {
+      break;
+    }
   }
+  work();
+  for (std::thread& helper : helpers) helper.join();
   if (first_error) std::rethrow_exception(first_error);
 }
 

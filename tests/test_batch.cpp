@@ -1,7 +1,12 @@
-// proximity_batch: every entry equals the single call, for every pair type and thread count;
-// bad rows are reported by index.
+// proximity_batch: every entry equals the single call, for every pair type and thread count (any
+// count, however large, and also when the system refuses threads); bad rows are reported by index.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
+#include <climits>
+#include <cstdlib>
+#include <fstream>
+#include <string>
 #include <thread>
 
 #include "diffpills/diffpills.hpp"
@@ -26,6 +31,18 @@ Arrays random_arrays(Rng& rng, Eigen::Index n) {
     arrays.q_b.row(i) = b.q().transpose();
   }
   return arrays;
+}
+
+// True if every row of the batch is bit-identical to the single call on its poses.
+bool equals_single_calls(const Shape& a, const Shape& b, const Arrays& arrays,
+                         const Eigen::VectorXd& phi, const GradientArray& gradient) {
+  for (Eigen::Index i = 0; i < phi.size(); ++i) {
+    const Proximity single =
+        proximity(a, Pose(arrays.r_a.row(i).transpose(), arrays.q_a.row(i).transpose()), b,
+                  Pose(arrays.r_b.row(i).transpose(), arrays.q_b.row(i).transpose()));
+    if (phi(i) != single.phi || gradient.row(i) != single.gradient.transpose()) return false;
+  }
+  return true;
 }
 
 TEST(Batch, EveryEntryEqualsTheSingleCall) {
@@ -58,7 +75,7 @@ TEST(Batch, ReportsTheFirstBadRow) {
   Arrays arrays = random_arrays(rng, 500);
   arrays.q_b.row(317).setZero();
   arrays.r_a(401, 2) = std::nan("");
-  for (int threads : {1, 2, 4}) {
+  for (int threads : {1, 2, 4, 1'000'000}) {
     try {
       proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b, {threads});
       ADD_FAILURE() << "no exception";
@@ -76,6 +93,82 @@ TEST(Batch, ReportsTheFirstBadRow) {
   }
 }
 
+TEST(Batch, AMillionThreadsAreCappedAndGiveTheSingleCalls) {
+  // 10^6 rows asked of 10^6 threads once started one thread per 512-row block (1954), and the
+  // process ended when the system refused one.
+  Rng rng(64);
+  const Shape capsule = random_capsule(rng, 1.0).shape;
+  const Arrays arrays = random_arrays(rng, 1'000'000);
+  const BatchResult batch = proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b,
+                                            arrays.q_b, {1'000'000});
+  EXPECT_TRUE(equals_single_calls(capsule, capsule, arrays, batch.phi, batch.gradient));
+  const BatchResult most =
+      proximity_batch(capsule, arrays.r_a.topRows(1000), arrays.q_a.topRows(1000), capsule,
+                      arrays.r_b.topRows(1000), arrays.q_b.topRows(1000), {INT_MAX});
+  EXPECT_TRUE(equals_single_calls(capsule, capsule, arrays, most.phi, most.gradient));
+}
+
+// Address-space limits do not mix with the sanitizers' shadow memory.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define DIFFPILLS_TEST_SANITIZED
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define DIFFPILLS_TEST_SANITIZED
+#endif
+#ifdef DIFFPILLS_TEST_SANITIZED
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+
+// The process's address space (VmSize of /proc/self/status), in bytes.
+rlim_t address_space() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmSize:", 0) == 0) return std::stoull(line.substr(7)) * 1024;
+  }
+  return 0;
+}
+
+// Runs a 20,000-row batch (40 blocks) in a child process whose address space may grow by only
+// `headroom` bytes past its inputs and outputs, so that the system refuses threads once their
+// stacks (8 MB each by default) no longer fit; the child exits with 0 if every row equals the
+// single call. A fresh process ("threadsafe" death tests re-run the binary) has no cached thread
+// stacks to reuse.
+void expect_batch_within_address_space(rlim_t headroom, int threads) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  Rng rng(65);
+  const Shape capsule = random_capsule(rng, 1.0).shape;
+  const Arrays arrays = random_arrays(rng, 20'000);
+  Eigen::VectorXd phi(20'000);
+  GradientArray gradient(20'000, 14);
+  EXPECT_EXIT(
+      {
+        rlimit limit{};
+        getrlimit(RLIMIT_AS, &limit);
+        limit.rlim_cur = address_space() + headroom;
+        setrlimit(RLIMIT_AS, &limit);
+        proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b, phi,
+                        gradient, {threads});
+        std::exit(equals_single_calls(capsule, capsule, arrays, phi, gradient) ? 0 : 1);
+      },
+      ::testing::ExitedWithCode(0), "");
+}
+
+TEST(Batch, StartsNoMoreThreadsThanHelp) {
+  if (kSanitized) GTEST_SKIP() << "address-space limit under a sanitizer";
+  // Room for a few thread stacks, not for one per block.
+  expect_batch_within_address_space(64 << 20, 1'000'000);
+}
+
+TEST(Batch, GoesOnWithTheCallingThreadWhenNoThreadStarts) {
+  if (kSanitized) GTEST_SKIP() << "address-space limit under a sanitizer";
+  // No room for any thread's stack: the calling thread computes every row.
+  for (int threads : {0, 2, 1'000'000}) expect_batch_within_address_space(1 << 20, threads);
+}
+
 TEST(Batch, RejectsMismatchedArraysAndBadThreadCounts) {
   Rng rng(63);
   const Shape capsule = Capsule(1.0, 0.1);
@@ -83,9 +176,11 @@ TEST(Batch, RejectsMismatchedArraysAndBadThreadCounts) {
   const PositionArray short_r = arrays.r_b.topRows(9);
   EXPECT_THROW(proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, short_r, arrays.q_b),
                std::invalid_argument);
-  EXPECT_THROW(
-      proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b, {-1}),
-      std::invalid_argument);
+  for (int threads : {-1, INT_MIN}) {
+    EXPECT_THROW(proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b,
+                                 {threads}),
+                 std::invalid_argument);
+  }
   Eigen::VectorXd phi(10);
   GradientArray gradient(9, 14);  // one row short
   EXPECT_THROW(proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b,

@@ -10,7 +10,12 @@
 namespace diffpills {
 
 struct BatchOptions {
-  int threads = 0;  // worker threads; 0 = every hardware thread
+  // Threads working on the batch, the calling thread included; 0 = every hardware thread. Capped
+  // at the hardware threads and at one per 512-row block (more would only wait), so any count is
+  // safe; a negative one throws std::invalid_argument. If the system cannot start a thread, the
+  // batch runs on those that did start (at worst on the calling thread alone) with the same
+  // results: running out of threads is never an error.
+  int threads = 0;
   Method method = Method::kDefault;
 };
 
@@ -26,8 +31,9 @@ struct BatchResult {
 
 // phi and the 14-entry gradient for pair i = (a at (r_a[i], q_a[i]), b at (r_b[i], q_b[i])).
 // Throws std::invalid_argument if the arrays differ in length or a pose is invalid; the message
-// names the first bad row, e.g. "q_b[17]: quaternion must be nonzero ...". The per-pair work
-// allocates nothing for polygons of up to 32 vertices.
+// names the first bad row, e.g. "q_b[17]: quaternion must be nonzero ...". An exception of a row
+// (that one, or a SolverError) is thrown to the caller after every thread has finished, whichever
+// thread met it. The per-pair work allocates nothing for polygons of up to 32 vertices.
 BatchResult proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
                             const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
                             const Eigen::Ref<const PositionArray>& r_b,

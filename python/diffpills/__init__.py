@@ -11,7 +11,8 @@ Shapes: ``Capsule(length, radius)`` and ``PaddedPolygon(C, d, radius)``, each po
     phi (N,) and gradients (N, 14) for arrays of poses, on every core, without the GIL.
 
 ``phi = ||p1 - p2||^2 - (R1 + R2)^2`` is negative exactly when the shapes overlap. Bad input raises
-ValueError naming the field. ``import diffpills.torch`` for ``diffpills.torch.proximity``, a
+ValueError (a bad value or shape) or TypeError (a wrong type: complex numbers, a str, a tensor that
+requires grad) naming the field. ``import diffpills.torch`` for ``diffpills.torch.proximity``, a
 PyTorch autograd function over batches (not imported here, so that ``import diffpills`` stays fast
 without PyTorch).
 """

@@ -1,5 +1,7 @@
 # Type stubs for diffpills._core (the pybind11 module), re-exported by the package diffpills.
-from typing import Literal, Optional, Tuple, Union
+# Arrays and numbers must hold real numbers (floats or ints of any width); complex, bool and str
+# raise TypeError at run time.
+from typing import Literal, Optional, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -32,7 +34,10 @@ class PaddedPolygon:
 Shape = Union[Capsule, PaddedPolygon]
 
 class Pose:
-    def __init__(self, r: ArrayLike = ..., q: ArrayLike = ...) -> None: ...
+    @overload
+    def __init__(self) -> None: ...
+    @overload
+    def __init__(self, r: ArrayLike, q: ArrayLike) -> None: ...
     @property
     def r(self) -> np.ndarray: ...
     @property

@@ -78,10 +78,12 @@ def proximity(a, r_a, q_a, b, r_b, q_b, threads=0, method="default"):
     a, b: ``diffpills.Capsule`` or ``diffpills.PaddedPolygon``.
     r_a, r_b: (N, 3) tensors; q_a, q_b: (N, 4) quaternions [w, x, y, z] (need not be unit: they
     are normalized inside, and the gradient includes that). Any of the four may be a single pose,
-    (3,) or (4,) or one row, shared by all N pairs (its gradient is then summed over the pairs).
-    All four must share one dtype (float64 or float32) and device.
+    (3,) or (4,) or one row, shared by all N pairs (its gradient is then summed over the pairs);
+    N may be 0. All four must share one dtype (float64 or float32) and device.
+    threads, method: as for ``diffpills.proximity_batch``.
     Differentiable with respect to all four; the backward pass uses the exact gradient.
-    Raises ValueError for bad shapes or values (naming the argument and row).
+    Raises ValueError for bad shapes or values, TypeError for wrong types (naming the argument,
+    and the row of a bad value).
     """
     r_a, q_a = _rows("r_a", r_a, 3), _rows("q_a", q_a, 4)
     r_b, q_b = _rows("r_b", r_b, 3), _rows("q_b", q_b, 4)
@@ -91,10 +93,16 @@ def proximity(a, r_a, q_a, b, r_b, q_b, threads=0, method="default"):
             raise ValueError(f"{name}: expected float64 or float32, got {tensor.dtype}")
         if tensor.dtype != r_a.dtype or tensor.device != r_a.device:
             raise ValueError(f"{name}: dtype and device must match r_a's")
-    n = max(t.shape[0] for t in tensors.values())
+    # N is the row count of the tensors that are not a single pose (1 if all are): the largest row
+    # count would make a 0-row batch with a shared pose fail, 0 rows against 1.
+    n, n_from = 1, None
     for name, tensor in tensors.items():
-        if tensor.shape[0] not in (1, n):
-            raise ValueError(f"{name}: has {tensor.shape[0]} rows, the others {n}")
+        if tensor.shape[0] == 1:
+            continue
+        if n_from is None:
+            n, n_from = tensor.shape[0], name
+        elif tensor.shape[0] != n:
+            raise ValueError(f"{name}: has {tensor.shape[0]} rows, {n_from} has {n}")
     # expand() is a view whose backward sums over the shared rows.
     r_a, q_a, r_b, q_b = (t.expand(n, t.shape[1]) for t in (r_a, q_a, r_b, q_b))
     return _Proximity.apply(a, b, threads, method, r_a, q_a, r_b, q_b)

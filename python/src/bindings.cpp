@@ -1,12 +1,14 @@
 // The Python module diffpills._core: the shapes, poses and queries of the C++ library, NumPy arrays
-// in and out. Inputs are checked here for their shapes (ValueError naming the argument) and by the
-// library for their values (std::invalid_argument, which pybind11 turns into ValueError with the
-// library's message). The package diffpills (python/diffpills/__init__.py) re-exports everything.
+// in and out. Inputs are checked here for their types (TypeError naming the argument) and shapes
+// (ValueError naming the argument), and by the library for their values (std::invalid_argument,
+// which pybind11 turns into ValueError with the library's message). The package diffpills
+// (python/diffpills/__init__.py) re-exports everything.
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include <algorithm>
+#include <climits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -16,15 +18,140 @@
 namespace py = pybind11;
 
 namespace diffpills::python {
+
+// False for an object made by T.__new__ without __init__ (or __setstate__): pybind11 2.10 then
+// hands out freshly allocated, uninitialised memory as the C++ value (type_caster_generic::
+// load_value), so reading it returns garbage or crashes. The test is pybind11's own for a Python
+// subclass that forgets to call __init__ (pybind11_meta_call). object must be a bound class's
+// instance.
+inline bool constructed(const py::handle& object) {
+  for (const auto& value_and_holder :
+       py::detail::values_and_holders(reinterpret_cast<py::detail::instance*>(object.ptr()))) {
+    if (!value_and_holder.holder_constructed()) return false;
+  }
+  return true;
+}
+
+inline std::string not_constructed(const py::handle& object) {
+  const std::string type = py::str(py::type::of(object).attr("__name__"));
+  return "this diffpills." + type + " was made by __new__ without __init__ and holds no value; " +
+         (py::isinstance<Proximity>(object)
+              ? "results come from diffpills.proximity and proximity_jacobian"
+              : "create it as diffpills." + type + "(...)");
+}
+
+// The caster of every bound class: pybind11's, refusing unconstructed objects with TypeError
+// wherever one is passed (as self of a method or property, __repr__, pickling, or an argument).
+template <class T>
+class ConstructedCaster : public py::detail::type_caster_base<T> {
+ public:
+  bool load(py::handle source, bool convert) {
+    if (py::isinstance<T>(source) && !constructed(source)) {
+      throw py::type_error(not_constructed(source));
+    }
+    return py::detail::type_caster_base<T>::load(source, convert);
+  }
+};
+
+}  // namespace diffpills::python
+
+namespace pybind11::detail {
+template <>
+class type_caster<diffpills::Capsule>
+    : public diffpills::python::ConstructedCaster<diffpills::Capsule> {};
+template <>
+class type_caster<diffpills::PaddedPolygon>
+    : public diffpills::python::ConstructedCaster<diffpills::PaddedPolygon> {};
+template <>
+class type_caster<diffpills::Pose> : public diffpills::python::ConstructedCaster<diffpills::Pose> {
+};
+template <>
+class type_caster<diffpills::Proximity>
+    : public diffpills::python::ConstructedCaster<diffpills::Proximity> {};
+template <>
+class type_caster<diffpills::ProximityJacobian>
+    : public diffpills::python::ConstructedCaster<diffpills::ProximityJacobian> {};
+}  // namespace pybind11::detail
+
+namespace diffpills::python {
 namespace {
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-// Any array-like as a C-contiguous float64 array, or ValueError naming the argument.
+std::string type_name(const py::handle& value) {
+  return py::str(py::type::of(value).attr("__name__"));
+}
+
+// numpy.asarray(value, dtype) (dtype null: NumPy's choice), with flags; an object NumPy cannot
+// read raises TypeError or ValueError naming the argument, with NumPy's (or the object's) reason.
+// MemoryError (a huge copy) and exceptions that are not errors (KeyboardInterrupt) pass as they
+// are.
+py::array numpy_array(const py::handle& value, py::dtype dtype, int flags,
+                      const std::string& name) {
+  PyObject* array = py::detail::npy_api::get().PyArray_FromAny_(
+      value.ptr(), dtype ? dtype.release().ptr() : nullptr, 0, 0,
+      flags | py::detail::npy_api::NPY_ARRAY_ENSUREARRAY_, nullptr);
+  if (array != nullptr) return py::reinterpret_steal<py::array>(array);
+  py::error_already_set error;
+  if (error.matches(PyExc_MemoryError) || !error.matches(PyExc_Exception)) throw error;
+  // A torch tensor that requires grad refuses to become an array (torch's RuntimeError names no
+  // argument). Detaching it here would silently cut it from its graph: the caller should decide.
+  if (py::hasattr(value, "requires_grad") && py::hasattr(value, "detach") &&
+      value.attr("requires_grad").ptr() == Py_True) {
+    throw py::type_error(name + ": a tensor that requires grad; pass " + name +
+                         ".detach() (diffpills.Pose and proximity_batch take plain numbers, "
+                         "outside autograd; diffpills.torch.proximity differentiates with respect "
+                         "to poses)");
+  }
+  const std::string message =
+      name + ": expected numbers (" + std::string(py::str(error.value())) + ")";
+  if (error.matches(PyExc_ValueError) || error.matches(PyExc_ArithmeticError)) {
+    throw py::value_error(message);
+  }
+  throw py::type_error(message);
+}
+
+// The first entry of an object array that is not a real number (numbers.Real, not a bool), or
+// null if all are: ints beyond 64 bits, Fractions and mixes of them with floats, which NumPy keeps
+// as objects, are numbers; None (which NumPy would read as NaN), str or complex are not.
+py::object first_non_real(const py::array& objects) {
+  const py::object real = py::module_::import("numbers").attr("Real");
+  for (const py::handle entry : objects.attr("flat")) {
+    if (!py::isinstance(entry, real) || py::isinstance<py::bool_>(entry)) {
+      return py::reinterpret_borrow<py::object>(entry);
+    }
+  }
+  return {};
+}
+
+// Any array-like of real numbers as a C-contiguous float64 array (the data itself if it is one
+// already, else a copy, so any strides are fine), or TypeError naming the argument. Floats of any
+// width, integers and object arrays of real numbers are values; complex numbers (whose imaginary
+// part a cast would drop), bools and strings are refused rather than guessed at.
 Array as_array(const py::handle& value, const std::string& name) {
-  Array array = Array::ensure(value);
-  if (!array) throw py::value_error(name + ": expected an array of numbers");
-  return array;
+  // The common case first, at no cost: float64 C-contiguous, used as it is.
+  if (Array::check_(value)) return py::reinterpret_borrow<Array>(value);
+  const py::array any = py::isinstance<py::array>(value) ? py::reinterpret_borrow<py::array>(value)
+                                                         : numpy_array(value, py::dtype(), 0, name);
+  const char kind = any.dtype().kind();
+  if (kind == 'O') {
+    if (const py::object entry = first_non_real(any)) {
+      throw py::type_error(name + ": expected real numbers, got " +
+                           (any.ndim() == 0 ? "" : "an array holding ") + type_name(entry));
+    }
+  } else if (kind != 'f' && kind != 'i' && kind != 'u') {
+    const bool text = kind == 'U' || kind == 'S';
+    throw py::type_error(
+        name + ": expected real numbers, got " +
+        (any.ndim() == 0
+             ? type_name(value)
+             : "an array of " + (text ? "strings" : std::string(py::str(any.dtype())))));
+  }
+  if (Array::check_(any)) return py::reinterpret_borrow<Array>(any);
+  return py::reinterpret_borrow<Array>(numpy_array(
+      any, py::dtype::of<double>(),
+      py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_FORCECAST_,
+      name));
 }
 
 std::string shape_of(const Array& array) {
@@ -45,19 +172,81 @@ Eigen::Matrix<double, N, 1> fixed_vector(const py::handle& value, const std::str
   return Eigen::Map<const Eigen::Matrix<double, N, 1>>(array.data());
 }
 
-Method to_method(const std::string& name) {
-  if (name == "default") return Method::kDefault;
-  if (name == "interior_point") return Method::kInteriorPoint;
-  throw py::value_error("method: expected \"default\" or \"interior_point\", got \"" + name + "\"");
+// A number given as a Python or NumPy scalar (or a 0-d array), read like the arrays: a complex,
+// bool or str is refused with TypeError naming the argument.
+double real_number(const py::handle& value, const std::string& name) {
+  // Python floats (NumPy's float64 is one) and ints skip NumPy, five times faster.
+  if (PyFloat_Check(value.ptr())) return PyFloat_AS_DOUBLE(value.ptr());
+  if (PyLong_CheckExact(value.ptr())) {
+    const double number = PyLong_AsDouble(value.ptr());
+    if (number != -1.0 || !PyErr_Occurred()) return number;
+    PyErr_Clear();  // beyond a double's range: refused below, naming the argument
+  }
+  const Array array = as_array(value, name);
+  if (array.ndim() != 0) {
+    throw py::value_error(name + ": expected a number, got shape " + shape_of(array));
+  }
+  return *array.data();
+}
+
+template <int R, int C>
+Eigen::Matrix<double, R, C> fixed_matrix(const py::handle& value, const std::string& name) {
+  const Array array = as_array(value, name);
+  if (array.ndim() != 2 || array.shape(0) != R || array.shape(1) != C) {
+    throw py::value_error(name + ": expected shape (" + std::to_string(R) + ", " +
+                          std::to_string(C) + "), got " + shape_of(array));
+  }
+  return Eigen::Map<const Eigen::Matrix<double, R, C, Eigen::RowMajor>>(array.data());
+}
+
+Method to_method(const py::handle& value) {
+  const std::string expected = "method: expected \"default\" or \"interior_point\", got ";
+  if (!py::isinstance<py::str>(value)) throw py::type_error(expected + type_name(value));
+  // Compared as Python strings: a str with a lone surrogate has no UTF-8 std::string.
+  if (PyUnicode_CompareWithASCIIString(value.ptr(), "default") == 0) return Method::kDefault;
+  if (PyUnicode_CompareWithASCIIString(value.ptr(), "interior_point") == 0) {
+    return Method::kInteriorPoint;
+  }
+  throw py::value_error(expected + std::string(py::repr(value)));
+}
+
+// threads as an int of BatchOptions: a Python or NumPy integer from 0 to INT_MAX (counts above
+// the hardware threads are capped by the library). A bool or a float is a mistake, not a count.
+int thread_count(const py::handle& value) {
+  if (py::isinstance<py::bool_>(value) || !PyIndex_Check(value.ptr())) {
+    throw py::type_error("threads: expected an int, got " + type_name(value));
+  }
+  const auto number = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!number) throw py::error_already_set();
+  int overflow = 0;
+  const long long count = PyLong_AsLongLongAndOverflow(number.ptr(), &overflow);
+  if (overflow != 0 || count < 0 || count > INT_MAX) {
+    throw py::value_error("threads: must be from 0 (every hardware thread) to " +
+                          std::to_string(INT_MAX) + ", got " + std::string(py::str(number)));
+  }
+  return static_cast<int>(count);
+}
+
+// The C++ value of an argument of a bound class, or TypeError naming the argument if it was
+// never constructed.
+template <class T>
+const T& value_of(const py::handle& object, const std::string& name) {
+  if (!constructed(object)) throw py::type_error(name + ": " + not_constructed(object));
+  // pybind11's own caster: ConstructedCaster would repeat the checks, a third of a call's time.
+  py::detail::type_caster_base<T> caster;
+  if (!caster.load(object, /*convert=*/false)) {
+    throw py::type_error(name + ": expected " + py::type_id<T>());
+  }
+  return *static_cast<const T*>(caster.value);
 }
 
 // Calls f with the shape behind a Python object (a Capsule or a PaddedPolygon, by reference).
 template <class F>
 decltype(auto) with_shape(const py::handle& object, const std::string& name, F&& f) {
-  if (py::isinstance<Capsule>(object)) return f(object.cast<const Capsule&>());
-  if (py::isinstance<PaddedPolygon>(object)) return f(object.cast<const PaddedPolygon&>());
+  if (py::isinstance<Capsule>(object)) return f(value_of<Capsule>(object, name));
+  if (py::isinstance<PaddedPolygon>(object)) return f(value_of<PaddedPolygon>(object, name));
   throw py::type_error(name + ": expected diffpills.Capsule or diffpills.PaddedPolygon, got " +
-                       std::string(py::str(py::type::of(object).attr("__name__"))));
+                       type_name(object));
 }
 
 Shape to_shape(const py::handle& object, const std::string& name) {
@@ -66,10 +255,21 @@ Shape to_shape(const py::handle& object, const std::string& name) {
 
 const Pose& to_pose(const py::handle& object, const std::string& name) {
   if (!py::isinstance<Pose>(object)) {
-    throw py::type_error(name + ": expected diffpills.Pose, got " +
-                         std::string(py::str(py::type::of(object).attr("__name__"))));
+    throw py::type_error(name + ": expected diffpills.Pose, got " + type_name(object));
   }
-  return object.cast<const Pose&>();
+  return value_of<Pose>(object, name);
+}
+
+// The state a __getstate__ below made: a tuple of `size` entries, or an error naming the fields.
+py::tuple pickled_state(const py::handle& state, std::size_t size, const std::string& fields) {
+  if (!py::isinstance<py::tuple>(state)) {
+    throw py::type_error("__setstate__: expected a tuple " + fields + ", got " + type_name(state));
+  }
+  if (py::len(state) != size) {
+    throw py::value_error("__setstate__: expected a tuple " + fields + ", got " +
+                          std::to_string(py::len(state)) + " entries");
+  }
+  return py::reinterpret_borrow<py::tuple>(state);
 }
 
 py::array_t<double> points_array(const std::array<Eigen::Vector3d, 2>& points) {
@@ -82,11 +282,8 @@ py::array_t<double> points_array(const std::array<Eigen::Vector3d, 2>& points) {
 }
 
 std::array<Eigen::Vector3d, 2> points_from(const py::handle& value, const std::string& name) {
-  const Array array = as_array(value, name);
-  if (array.ndim() != 2 || array.shape(0) != 2 || array.shape(1) != 3) {
-    throw py::value_error(name + ": expected shape (2, 3), got " + shape_of(array));
-  }
-  return {Eigen::Vector3d(array.data(0, 0)), Eigen::Vector3d(array.data(1, 0))};
+  const Eigen::Matrix<double, 2, 3> points = fixed_matrix<2, 3>(value, name);
+  return {points.row(0).transpose(), points.row(1).transpose()};
 }
 
 template <int Width>
@@ -110,6 +307,7 @@ class BatchInput {
 
   Eigen::Index rows() const { return rows_; }
   const std::string& name() const { return name_; }
+  const Array& array() const { return array_; }
 
   // The N x Width rows: the NumPy data itself, or the single pose repeated N times.
   Eigen::Map<const Rows<Width>> view(Eigen::Index n) {
@@ -125,13 +323,34 @@ class BatchInput {
   Rows<Width> repeated_;
 };
 
+PaddedPolygon polygon_from(const py::handle& C, const py::handle& d, const py::handle& radius) {
+  const Array c_array = as_array(C, "C");
+  if (c_array.ndim() != 2 || c_array.shape(1) != 2) {
+    throw py::value_error("C: expected shape (m, 2), got " + shape_of(c_array));
+  }
+  const Array d_array = as_array(d, "d");
+  if (d_array.ndim() != 1) {
+    throw py::value_error("d: expected shape (m,), got " + shape_of(d_array));
+  }
+  const Eigen::MatrixX2d c_matrix =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(
+          c_array.data(), c_array.shape(0), 2);
+  const Eigen::VectorXd d_vector =
+      Eigen::Map<const Eigen::VectorXd>(d_array.data(), d_array.shape(0));
+  return PaddedPolygon(c_matrix, d_vector, real_number(radius, "radius"));
+}
+
 void bind_shapes(py::module_& m) {
   py::class_<Capsule>(m, "Capsule",
                       R"(A capsule: a segment of the given length along the body x axis,
 from [-length/2, 0, 0] to [length/2, 0, 0], padded by radius. length 0 is a sphere.
 
-Raises ValueError for negative or non-finite sizes.)")
-      .def(py::init<double, double>(), py::arg("length"), py::arg("radius"))
+Raises ValueError for negative or non-finite sizes, TypeError for a size that is not a real
+number.)")
+      .def(py::init([](const py::handle& length, const py::handle& radius) {
+             return Capsule(real_number(length, "length"), real_number(radius, "radius"));
+           }),
+           py::arg("length"), py::arg("radius"))
       .def_property_readonly("length", &Capsule::length, "Length of the core segment.")
       .def_property_readonly("radius", &Capsule::radius, "Padding radius.")
       .def("__repr__",
@@ -140,10 +359,14 @@ Raises ValueError for negative or non-finite sizes.)")
              out << "diffpills.Capsule(length=" << c.length() << ", radius=" << c.radius() << ")";
              return out.str();
            })
-      .def(py::pickle([](const Capsule& c) { return py::make_tuple(c.length(), c.radius()); },
-                      [](const py::tuple& state) {
-                        return Capsule(state[0].cast<double>(), state[1].cast<double>());
-                      }));
+      // Pickles: the getters return py::object, the type the setters take (pybind11 wants them
+      // alike), so that a setter can refuse a state that is not a tuple with its own message.
+      .def(py::pickle(
+          [](const Capsule& c) -> py::object { return py::make_tuple(c.length(), c.radius()); },
+          [](const py::object& state) {
+            const py::tuple fields = pickled_state(state, 2, "(length, radius)");
+            return Capsule(real_number(fields[0], "length"), real_number(fields[1], "radius"));
+          }));
 
   py::class_<PaddedPolygon>(m, "PaddedPolygon",
                             R"(A padded polygon: the convex polygon {y : C y <= d}
@@ -151,23 +374,7 @@ in the body x-y plane, padded by radius.
 
 C is (m, 2) and d is (m,), m >= 3, with d > 0 (the body origin strictly inside) and the polygon
 bounded. Redundant rows are allowed and dropped. Raises ValueError naming the violated field.)")
-      .def(py::init([](const py::handle& C, const py::handle& d, double radius) {
-             const Array c_array = as_array(C, "C");
-             if (c_array.ndim() != 2 || c_array.shape(1) != 2) {
-               throw py::value_error("C: expected shape (m, 2), got " + shape_of(c_array));
-             }
-             const Array d_array = as_array(d, "d");
-             if (d_array.ndim() != 1) {
-               throw py::value_error("d: expected shape (m,), got " + shape_of(d_array));
-             }
-             const Eigen::MatrixX2d c_matrix =
-                 Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(
-                     c_array.data(), c_array.shape(0), 2);
-             const Eigen::VectorXd d_vector =
-                 Eigen::Map<const Eigen::VectorXd>(d_array.data(), d_array.shape(0));
-             return PaddedPolygon(c_matrix, d_vector, radius);
-           }),
-           py::arg("C"), py::arg("d"), py::arg("radius"))
+      .def(py::init(&polygon_from), py::arg("C"), py::arg("d"), py::arg("radius"))
       .def_property_readonly("C", &PaddedPolygon::constraint_matrix, "The rows as given, (m, 2).")
       .def_property_readonly("d", &PaddedPolygon::constraint_offsets, "The offsets as given, (m,).")
       .def_property_readonly("radius", &PaddedPolygon::radius, "Padding radius.")
@@ -182,19 +389,22 @@ bounded. Redundant rows are allowed and dropped. Raises ValueError naming the vi
              return out.str();
            })
       .def(py::pickle(
-          [](const PaddedPolygon& p) {
+          [](const PaddedPolygon& p) -> py::object {
             return py::make_tuple(p.constraint_matrix(), p.constraint_offsets(), p.radius());
           },
-          [](const py::tuple& state) {
-            return PaddedPolygon(state[0].cast<Eigen::MatrixX2d>(),
-                                 state[1].cast<Eigen::VectorXd>(), state[2].cast<double>());
+          [](const py::object& state) {
+            const py::tuple fields = pickled_state(state, 3, "(C, d, radius)");
+            return polygon_from(fields[0], fields[1], fields[2]);
           }));
 
   py::class_<Pose>(m, "Pose", R"(A rigid-body pose: x_world = r + R(q) x_body.
 
 r is a position (3,), q a quaternion [w, x, y, z] (4,), scalar first. q need not be unit: it is
 normalized wherever it is used, and gradients include that normalization. Pose() is the identity.
-Raises ValueError for non-finite entries or a zero quaternion.)")
+Raises ValueError for non-finite entries, a zero quaternion or a wrong shape, TypeError for entries
+that are not real numbers (complex, bool, str) and for a torch tensor that requires grad: a Pose
+holds plain numbers, outside autograd, so pass r.detach() (diffpills.torch.proximity differentiates
+with respect to poses).)")
       .def(py::init<>())
       .def(py::init([](const py::handle& r, const py::handle& q) {
              return Pose(fixed_vector<3>(r, "r"), fixed_vector<4>(q, "q"));
@@ -209,25 +419,35 @@ Raises ValueError for non-finite entries or a zero quaternion.)")
                  << "])";
              return out.str();
            })
-      .def(py::pickle([](const Pose& p) { return py::make_tuple(p.r(), p.q()); },
-                      [](const py::tuple& state) {
-                        return Pose(state[0].cast<Eigen::Vector3d>(),
-                                    state[1].cast<Eigen::Vector4d>());
+      .def(py::pickle([](const Pose& p) -> py::object { return py::make_tuple(p.r(), p.q()); },
+                      [](const py::object& state) {
+                        const py::tuple fields = pickled_state(state, 2, "(r, q)");
+                        return Pose(fixed_vector<3>(fields[0], "r"),
+                                    fixed_vector<4>(fields[1], "q"));
                       }));
 }
 
-py::tuple proximity_state(const Proximity& p) {
+py::object proximity_state(const Proximity& p) {
   return py::make_tuple(p.phi, points_array(p.core_points), points_array(p.points), p.normal,
                         p.cores_intersect, p.gradient);
 }
 
-void restore_proximity(Proximity& p, const py::tuple& state) {
-  p.phi = state[0].cast<double>();
-  p.core_points = points_from(state[1], "core_points");
-  p.points = points_from(state[2], "points");
-  p.normal = fixed_vector<3>(state[3], "normal");
-  p.cores_intersect = state[4].cast<bool>();
-  p.gradient = fixed_vector<14>(state[5], "gradient");
+constexpr const char* kProximityFields =
+    "(phi, core_points, points, normal, cores_intersect, gradient)";
+
+void restore_proximity(Proximity& p, const py::handle& state) {
+  const py::tuple fields = pickled_state(state, 6, kProximityFields);
+  p.phi = real_number(fields[0], "phi");
+  p.core_points = points_from(fields[1], "core_points");
+  p.points = points_from(fields[2], "points");
+  p.normal = fixed_vector<3>(fields[3], "normal");
+  // True or False (or NumPy's), not any object's truth value.
+  py::detail::make_caster<bool> cores_intersect;
+  if (!cores_intersect.load(fields[4], /*convert=*/false)) {
+    throw py::type_error("cores_intersect: expected a bool, got " + type_name(fields[4]));
+  }
+  p.cores_intersect = static_cast<bool>(cores_intersect);
+  p.gradient = fixed_vector<14>(fields[5], "gradient");
 }
 
 void bind_results(py::module_& m) {
@@ -253,7 +473,7 @@ gradient         (14,): d phi / d[r_a, q_a, r_b, q_b])")
                  << "], cores_intersect=" << (p.cores_intersect ? "True" : "False") << ")";
              return out.str();
            })
-      .def(py::pickle(&proximity_state, [](const py::tuple& state) {
+      .def(py::pickle(&proximity_state, [](const py::object& state) {
         Proximity p;
         restore_proximity(p, state);
         return p;
@@ -268,14 +488,18 @@ points_jacobian       (6, 14): d[surface point a; surface point b] / d[r_a, q_a,
       .def_readonly("core_points_jacobian", &ProximityJacobian::core_points_jacobian)
       .def_readonly("points_jacobian", &ProximityJacobian::points_jacobian)
       .def(py::pickle(
-          [](const ProximityJacobian& p) {
+          [](const ProximityJacobian& p) -> py::object {
             return py::make_tuple(proximity_state(p), p.core_points_jacobian, p.points_jacobian);
           },
-          [](const py::tuple& state) {
+          [](const py::object& state) {
+            const py::tuple fields =
+                pickled_state(state, 3,
+                              std::string("(") + kProximityFields + ", core_points_jacobian, " +
+                                  "points_jacobian)");
             ProximityJacobian p;
-            restore_proximity(p, state[0].cast<py::tuple>());
-            p.core_points_jacobian = state[1].cast<Eigen::Matrix<double, 6, 14>>();
-            p.points_jacobian = state[2].cast<Eigen::Matrix<double, 6, 14>>();
+            restore_proximity(p, fields[0]);
+            p.core_points_jacobian = fixed_matrix<6, 14>(fields[1], "core_points_jacobian");
+            p.points_jacobian = fixed_matrix<6, 14>(fields[2], "points_jacobian");
             return p;
           }));
 }
@@ -283,7 +507,7 @@ points_jacobian       (6, 14): d[surface point a; surface point b] / d[r_a, q_a,
 // proximity / proximity_jacobian on two shapes of any type.
 template <class Result, class Query>
 Result query(const py::handle& a, const py::handle& pose_a, const py::handle& b,
-             const py::handle& pose_b, const std::string& method, const Query& call) {
+             const py::handle& pose_b, const py::handle& method, const Query& call) {
   const ProximityOptions options{to_method(method)};
   const Pose& first = to_pose(pose_a, "pose_a");
   const Pose& second = to_pose(pose_b, "pose_b");
@@ -313,22 +537,38 @@ py::array_t<double> output_array(const py::handle& value, const std::string& nam
   return array;
 }
 
+// Whether two C-contiguous arrays share bytes. The threads write the outputs while reading the
+// inputs, so an output laid over an input (or over the other output) would give results that
+// depend on the thread timing, and two threads writing one double is a data race.
+bool overlap(const py::array& x, const py::array& y) {
+  const auto* x_begin = static_cast<const char*>(x.data());
+  const auto* y_begin = static_cast<const char*>(y.data());
+  return x.nbytes() > 0 && y.nbytes() > 0 && x_begin < y_begin + y.nbytes() &&
+         y_begin < x_begin + x.nbytes();
+}
+
 py::tuple batch(const py::handle& a, const py::handle& r_a, const py::handle& q_a,
-                const py::handle& b, const py::handle& r_b, const py::handle& q_b, int threads,
-                const std::string& method, const py::object& out) {
-  if (threads < 0) throw py::value_error("threads: must be >= 0 (0 = every core)");
+                const py::handle& b, const py::handle& r_b, const py::handle& q_b,
+                const py::handle& threads, const py::handle& method, const py::handle& out) {
+  const BatchOptions options{thread_count(threads), to_method(method)};
   const Shape shape_a = to_shape(a, "a"), shape_b = to_shape(b, "b");
   BatchInput<3> r_first(r_a, "r_a"), r_second(r_b, "r_b");
   BatchInput<4> q_first(q_a, "q_a"), q_second(q_b, "q_b");
-  const Eigen::Index n =
-      std::max({r_first.rows(), q_first.rows(), r_second.rows(), q_second.rows()});
+  // N is the row count of the arrays that are not a single pose (1 if all are). Taking the
+  // largest row count instead made a 0-row batch with a single pose fail (0 rows against 1).
+  Eigen::Index n = 1;
+  const std::string* n_from = nullptr;
   for (auto [rows, name] : {std::pair{r_first.rows(), &r_first.name()},
                             {q_first.rows(), &q_first.name()},
                             {r_second.rows(), &r_second.name()},
                             {q_second.rows(), &q_second.name()}}) {
-    if (rows != 1 && rows != n) {
-      throw py::value_error(*name + ": has " + std::to_string(rows) + " rows, the others " +
-                            std::to_string(n));
+    if (rows == 1) continue;
+    if (n_from == nullptr) {
+      n = rows;
+      n_from = name;
+    } else if (rows != n) {
+      throw py::value_error(*name + ": has " + std::to_string(rows) + " rows, " + *n_from +
+                            " has " + std::to_string(n));
     }
   }
   const auto ra = r_first.view(n), rb = r_second.view(n);
@@ -338,18 +578,27 @@ py::tuple batch(const py::handle& a, const py::handle& r_a, const py::handle& q_
     phi = py::array_t<double>(n);
     gradient = py::array_t<double>({n, static_cast<Eigen::Index>(14)});
   } else {
-    if (!py::isinstance<py::tuple>(out) || py::len(out) != 2) {
-      throw py::value_error("out: expected a tuple (phi, gradient)");
+    if (!py::isinstance<py::tuple>(out)) {
+      throw py::type_error("out: expected a tuple (phi, gradient), got " + type_name(out));
     }
+    if (py::len(out) != 2) throw py::value_error("out: expected a tuple (phi, gradient)");
     phi = output_array(out[py::int_(0)], "out[0]", {n});
     gradient = output_array(out[py::int_(1)], "out[1]", {n, 14});
+    if (overlap(phi, gradient)) throw py::value_error("out: phi and gradient share memory");
+    for (const auto* input :
+         {&r_first.array(), &q_first.array(), &r_second.array(), &q_second.array()}) {
+      for (auto [output, name] : {std::pair{&phi, "out[0]"}, {&gradient, "out[1]"}}) {
+        if (overlap(*output, *input)) {
+          throw py::value_error(std::string(name) + ": shares memory with an input array");
+        }
+      }
+    }
   }
   Eigen::Map<Eigen::VectorXd> phi_view(phi.mutable_data(), n);
   Eigen::Map<GradientArray> gradient_view(gradient.mutable_data(), n, 14);
   {
     py::gil_scoped_release release;
-    proximity_batch(shape_a, ra, qa, shape_b, rb, qb, phi_view, gradient_view,
-                    BatchOptions{threads, to_method(method)});
+    proximity_batch(shape_a, ra, qa, shape_b, rb, qb, phi_view, gradient_view, options);
   }
   return py::make_tuple(phi, gradient);
 }
@@ -373,8 +622,9 @@ quaternion [w, x, y, z]. For any pair:
 
 phi = ||p1 - p2||^2 - (R1 + R2)^2 is negative exactly when the shapes overlap. The gradient layout
 is [r_a (3), q_a (4), r_b (3), q_b (4)]. method="interior_point" selects the paper's solver
-instead of the exact fast paths (same answers, slower). Bad input raises ValueError naming the
-field; import diffpills.torch for a PyTorch autograd function over batches.)";
+instead of the exact fast paths (same answers, slower). Bad input raises ValueError (a bad value or
+shape) or TypeError (a wrong type: a str, complex numbers, an object made by __new__ alone) naming
+the field; import diffpills.torch for a PyTorch autograd function over batches.)";
   m.attr("__version__") = kVersion;
   py::register_exception<SolverError>(m, "SolverError", PyExc_RuntimeError).attr("__doc__") =
       "Raised when the QP solver does not converge (never seen for valid shapes in the tests); "
@@ -385,7 +635,7 @@ field; import diffpills.torch for a PyTorch autograd function over batches.)";
   m.def(
       "proximity",
       [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
-         const py::handle& pose_b, const std::string& method) {
+         const py::handle& pose_b, const py::handle& method) {
         return query<Proximity>(a, pose_a, b, pose_b, method,
                                 [](const auto&... args) { return proximity(args...); });
       },
@@ -398,7 +648,7 @@ gradient (14,) = d phi / d[r_a, q_a, r_b, q_b]. method: "default" or "interior_p
   m.def(
       "proximity_jacobian",
       [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
-         const py::handle& pose_b, const std::string& method) {
+         const py::handle& pose_b, const py::handle& method) {
         return query<ProximityJacobian>(a, pose_a, b, pose_b, method, [](const auto&... args) {
           return proximity_jacobian(args...);
         });
@@ -414,11 +664,13 @@ gradient (14,) = d phi / d[r_a, q_a, r_b, q_b]. method: "default" or "interior_p
 
 r_a, r_b: (N, 3) positions; q_a, q_b: (N, 4) quaternions [w, x, y, z]. Any of them may be a single
 pose ((3,) or (4,), or one row), used for every row. Returns (phi (N,), gradient (N, 14)), each
-row equal to proximity(a, Pose(r_a[i], q_a[i]), b, Pose(r_b[i], q_b[i])). threads: worker
-threads, 0 = every core; the GIL is released while they run. A bad row raises ValueError naming
-it, e.g. "q_b[17]: ...".
+row equal to proximity(a, Pose(r_a[i], q_a[i]), b, Pose(r_b[i], q_b[i])); N may be 0. Arrays of
+floats or ints of any layout are read (a float64 C-contiguous one in place); complex, bool, str and
+object arrays raise TypeError. threads: an int, 0 = every hardware thread; the calling thread works
+too, and more threads than the hardware's or than 512-row blocks are not started. The GIL is
+released while they run. A bad row raises ValueError naming it, e.g. "q_b[17]: ...".
 
-out: optionally (phi, gradient), float64 C-contiguous arrays of shapes (N,) and (N, 14) to write
-into and return, for loops that call the batch repeatedly (fresh outputs cost page faults, which
+out: optionally (phi, gradient), writable float64 C-contiguous arrays of shapes (N,) and (N, 14),
+sharing no memory with each other or the inputs, to write into and return, for loops that call the batch repeatedly (fresh outputs cost page faults, which
 the kernel serializes across threads: measured 1.5x slower with 2 threads for 10^5 capsules).)");
 }

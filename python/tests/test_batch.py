@@ -1,7 +1,11 @@
-"""proximity_batch equals single calls row by row, for every pair type, any thread count and
-broadcast single poses; it releases the GIL; every object pickles."""
+"""proximity_batch equals single calls row by row, for every pair type, any thread count (also when
+threads cannot start) and broadcast single poses, with 0 rows too; it releases the GIL; every
+object pickles."""
 
+import os
 import pickle
+import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -103,3 +107,111 @@ def test_caller_owned_outputs_are_written_in_place():
     ]:
         with pytest.raises(ValueError, match=match):
             diffpills.proximity_batch(a, r_a, q_a, b, r_b, q_b, out=bad)
+
+
+def test_a_million_threads_give_the_single_calls():
+    # Counts above the hardware's are capped: 10**6 once meant a thread per 512-row block.
+    rng = np.random.default_rng(15)
+    a, _ = random_polygon(rng)
+    b, _ = random_capsule(rng)
+    r_a, q_a = random_poses(rng, 20_000)
+    r_b, q_b = random_poses(rng, 20_000)
+    phi, gradient = diffpills.proximity_batch(a, r_a, q_a, b, r_b, q_b, threads=10**6)
+    for i in range(0, 20_000, 97):
+        single = diffpills.proximity(a, diffpills.Pose(r_a[i], q_a[i]), b, diffpills.Pose(r_b[i], q_b[i]))
+        assert phi[i] == single.phi
+        np.testing.assert_array_equal(gradient[i], single.gradient)
+
+
+_LIMITED_BATCH = """
+import resource, sys
+import numpy as np
+import diffpills
+
+rng = np.random.default_rng(16)
+capsule = diffpills.Capsule(1.0, 0.2)
+poses = rng.uniform(-1, 1, (20_000, 3)), rng.normal(size=(20_000, 4)), np.zeros((20_000, 3)), rng.normal(size=(20_000, 4))
+expected, _ = diffpills.proximity_batch(capsule, poses[0], poses[1], capsule, poses[2], poses[3], threads=1)
+phi, gradient = np.empty(20_000), np.empty((20_000, 14))  # nothing left to allocate but threads
+with open("/proc/self/status") as status:
+    size = next(int(line.split()[1]) * 1024 for line in status if line.startswith("VmSize:"))
+_, hard = resource.getrlimit(resource.RLIMIT_AS)
+resource.setrlimit(resource.RLIMIT_AS, (size + int(sys.argv[1]), hard))
+diffpills.proximity_batch(capsule, poses[0], poses[1], capsule, poses[2], poses[3], threads=int(sys.argv[2]),
+                          out=(phi, gradient))
+sys.exit(0 if np.array_equal(phi, expected) else 1)
+"""
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/status"), reason="needs Linux's /proc")
+@pytest.mark.parametrize(
+    "headroom, threads",
+    [(64 << 20, 10**6), (1 << 20, 0), (1 << 20, 10**6)],
+    ids=["room for a few threads", "room for none", "room for none, 10**6 asked"],
+)
+def test_the_batch_survives_when_threads_cannot_start(headroom, threads):
+    # In a process whose address space can grow by only `headroom`, the system refuses a thread once
+    # its stack (8 MB by default) no longer fits. 10**6 threads over 40 blocks once started 40 and
+    # ended the process (std::terminate) at the first refusal; now the batch starts no more threads
+    # than there are cores, and goes on without those the system refuses.
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    child = subprocess.run(
+        [sys.executable, "-c", _LIMITED_BATCH, str(headroom), str(threads)], env=env, capture_output=True, text=True,
+        timeout=300,
+    )
+    assert child.returncode == 0, child.stderr
+
+
+@pytest.mark.parametrize("single", ["r_a", "q_a", "r_b", "q_b", "all but r_a"])
+def test_zero_rows_with_a_single_pose_give_empty_results(single):
+    capsule = diffpills.Capsule(1.0, 0.1)
+    arrays = {"r_a": np.zeros((0, 3)), "q_a": np.zeros((0, 4)), "r_b": np.zeros((0, 3)), "q_b": np.zeros((0, 4))}
+    pose = {"r_a": [0.0, 0.0, 0.0], "q_a": [1.0, 0.0, 0.0, 0.0], "r_b": [[0.0, 0.0, 1.0]], "q_b": [1.0, 0.0, 0.0, 0.0]}
+    for name in (["q_a", "r_b", "q_b"] if single == "all but r_a" else [single]):
+        arrays[name] = pose[name]
+    args = (capsule, arrays["r_a"], arrays["q_a"], capsule, arrays["r_b"], arrays["q_b"])
+    phi, gradient = diffpills.proximity_batch(*args)
+    assert phi.shape == (0,) and gradient.shape == (0, 14)
+    out = (np.empty(0), np.empty((0, 14)))
+    returned = diffpills.proximity_batch(*args, out=out)
+    assert returned[0] is out[0] and returned[1] is out[1]
+
+
+def test_caller_owned_outputs_must_not_overlap_anything():
+    # The threads write the outputs while they read the inputs: an overlap would make the results
+    # depend on the thread timing.
+    rng = np.random.default_rng(17)
+    capsule, _ = random_capsule(rng)
+    r, q = random_poses(rng, 10)
+    phi, gradient = np.empty(10), np.empty((10, 14))
+    shared = np.empty(10 * 14 + 10)
+    for out, match in [
+        ((shared[:10], shared[10:].reshape(10, 14)), None),  # adjacent, not overlapping: fine
+        ((gradient.reshape(-1)[5:15], gradient), "out: phi and gradient share memory"),
+        ((phi, np.empty((10, 14))), None),
+    ]:
+        if match is None:
+            diffpills.proximity_batch(capsule, r, q, capsule, r[::-1].copy(), q, out=out)
+        else:
+            with pytest.raises(ValueError, match=match):
+                diffpills.proximity_batch(capsule, r, q, capsule, r, q, out=out)
+    big = np.zeros((10, 14))
+    q_inside = big.reshape(-1)[:40].reshape(10, 4)  # float64, C-contiguous: read in place
+    q_inside[:] = q
+    with pytest.raises(ValueError, match=r"out\[1\]: shares memory with an input array"):
+        diffpills.proximity_batch(capsule, r, q_inside, capsule, r, q, out=(phi, big))
+    with pytest.raises(ValueError, match=r"out\[0\]: shares memory with an input array"):
+        diffpills.proximity_batch(capsule, phi.reshape(-1)[:9].reshape(3, 3), q[:3], capsule, r[:3], q[:3],
+                                  out=(phi[:3], gradient[:3]))
+    read_only = np.empty(10)
+    read_only.setflags(write=False)
+    for out, error, match in [
+        ((read_only, gradient), ValueError, r"out\[0\]: array is read-only"),
+        ([phi, gradient], TypeError, "out: expected a tuple"),
+        ((None, gradient), ValueError, r"out\[0\]"),
+        ((phi, gradient[:, :, None]), ValueError, r"out\[1\]: expected shape \(10, 14\)"),
+        ((phi.astype(np.float32), gradient), ValueError, r"out\[0\]"),
+        ((phi, gradient, phi), ValueError, "out"),
+    ]:
+        with pytest.raises(error, match=match):
+            diffpills.proximity_batch(capsule, r, q, capsule, r, q, out=out)

@@ -95,3 +95,59 @@ def test_bad_input():
         dtorch.proximity(capsule, r, torch.zeros(4, 4, dtype=torch.float64), capsule, r, q)
     with pytest.raises(TypeError, match="r_a"):
         dtorch.proximity(capsule, np.zeros((4, 3)), q, capsule, r, q)
+
+
+def test_a_pose_refuses_a_tensor_that_requires_grad():
+    # A Pose holds plain numbers outside autograd: reading a tensor that requires grad would silently
+    # cut it from its graph, so the error says to detach it (or to use diffpills.torch.proximity).
+    r = torch.zeros(3, dtype=torch.float64, requires_grad=True)
+    q = torch.tensor([1.0, 0.0, 0.0, 0.0], requires_grad=True)
+    with pytest.raises(TypeError, match=r"^r: a tensor that requires grad; pass r\.detach\(\)"):
+        diffpills.Pose(r, q.detach())
+    with pytest.raises(TypeError, match=r"^q: .*q\.detach\(\)"):
+        diffpills.Pose(r.detach(), q)
+    pose = diffpills.Pose(r.detach() + 1.0, q.detach())
+    np.testing.assert_array_equal(pose.r, [1.0, 1.0, 1.0])
+    capsule = diffpills.Capsule(1.0, 0.1)
+    with pytest.raises(TypeError, match=r"^q_b: .*q_b\.detach\(\)"):
+        diffpills.proximity_batch(capsule, r.detach(), q.detach(), capsule, r.detach(), q)
+    phi, _ = diffpills.proximity_batch(capsule, r.detach(), q.detach(), capsule, r.detach() + 1.0, q.detach())
+    assert phi.shape == (1,)
+
+
+@pytest.mark.parametrize("single", ["r_a", "q_b"])
+def test_zero_rows_with_a_single_pose(single):
+    capsule = diffpills.Capsule(1.0, 0.1)
+    tensors = {
+        "r_a": torch.zeros(0, 3, dtype=torch.float64, requires_grad=True),
+        "q_a": torch.zeros(0, 4, dtype=torch.float64, requires_grad=True),
+        "r_b": torch.zeros(0, 3, dtype=torch.float64, requires_grad=True),
+        "q_b": torch.zeros(0, 4, dtype=torch.float64, requires_grad=True),
+    }
+    tensors[single] = torch.tensor([1.0, 0.0, 0.0, 0.0][: 3 if single.startswith("r") else 4],
+                                   dtype=torch.float64, requires_grad=True)
+    phi = dtorch.proximity(capsule, tensors["r_a"], tensors["q_a"], capsule, tensors["r_b"], tensors["q_b"])
+    assert phi.shape == (0,)
+    phi.sum().backward()
+    assert tensors[single].grad.shape == tensors[single].shape and not tensors[single].grad.any()
+    assert tensors["q_a"].grad.shape == (0, 4)
+
+
+def test_mismatched_rows_and_bad_arguments_name_them():
+    capsule = diffpills.Capsule(1.0, 0.1)
+    r = torch.zeros(4, 3, dtype=torch.float64)
+    q = torch.tensor([[1.0, 0.0, 0.0, 0.0]] * 4, dtype=torch.float64)
+    with pytest.raises(ValueError, match=r"^r_b: has 3 rows, r_a has 4$"):
+        dtorch.proximity(capsule, r, q, capsule, r[:3], q)
+    with pytest.raises(ValueError, match="^q_a: expected shape"):
+        dtorch.proximity(capsule, r, q[:, :, None], capsule, r, q)
+    with pytest.raises(ValueError, match="^q_b: expected float64 or float32"):
+        dtorch.proximity(capsule, r, q, capsule, r, q.to(torch.complex128))
+    with pytest.raises(ValueError, match=r"^r_a\[1\]: must be finite"):
+        dtorch.proximity(capsule, r.index_fill(0, torch.tensor([1]), float("nan")), q, capsule, r, q)
+    with pytest.raises(ValueError, match="^threads"):
+        dtorch.proximity(capsule, r, q, capsule, r, q, threads=-1)
+    with pytest.raises(TypeError, match="^method"):
+        dtorch.proximity(capsule, r, q, capsule, r, q, method=None)
+    with pytest.raises(TypeError, match="^b: expected diffpills.Capsule"):
+        dtorch.proximity(capsule, r, q, "capsule", r, q)
