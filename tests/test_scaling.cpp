@@ -250,5 +250,32 @@ TEST(Scaling, PolygonBelowTheFramesResolution) {
   }
 }
 
+// Coplanar polygons, one 1e-84 the size of the other and beside it (found by fuzz_proximity):
+// the small one's rows in the large one's frame are a bundle of lines through one point, and the
+// half-plane sweep took that bundle for an overlap in one order of the shapes.
+TEST(Scaling, CoplanarSpeckBesideAHugePolygon) {
+  Eigen::MatrixX2d C(51, 2);
+  for (int k = 0; k < 51; ++k) C.row(k) << std::cos(2 * M_PI * k / 51), std::sin(2 * M_PI * k / 51);
+  const PaddedPolygon huge(C, Eigen::VectorXd::Constant(51, 1e70), 1e70);
+  const PaddedPolygon speck(C, Eigen::VectorXd::Constant(51, 5.75e-14), 1e70);
+  // The fuzzer's poses: half turns about z and (nearly) y, so that the planes are parallel and
+  // the speck's shadow is mirrored and skewed by 4e-9.
+  const Pose pose_huge({1e70, 1e70, 0}, Eigen::Vector4d(1.398e-76, 1.398e-76, 0, -2.875));
+  const Pose pose_speck({3, 0, 1.398e-76}, Eigen::Vector4d(9e-308, 1.398e-76, 7.522e-68, 3.66e-86));
+  const Proximity ab = proximity(huge, pose_huge, speck, pose_speck);
+  const Proximity ba = proximity(speck, pose_speck, huge, pose_huge);
+  EXPECT_FALSE(ab.cores_intersect);
+  EXPECT_FALSE(ba.cores_intersect);
+  EXPECT_LE((ab.core_points[1] - pose_speck.r()).norm(), 1e-12);
+  EXPECT_EQ(ab.core_points[0], ba.core_points[1]);
+  EXPECT_NEAR(ab.phi, ba.phi, 1e-12 * 4e140);
+  // The huge polygon's closest point is its vertex or edge toward (3, 0): at its circumradius
+  // from its centre at most, and the gap is the centre distance less that.
+  const double centre_distance = std::hypot(1e70 - 3, 1e70);
+  EXPECT_LE((ab.core_points[0] - pose_huge.r()).norm(), 1e70 / std::cos(M_PI / 51) * (1 + 1e-12));
+  EXPECT_GE((ab.core_points[0] - ab.core_points[1]).norm(),
+            centre_distance - 1e70 / std::cos(M_PI / 51) * (1 + 1e-12));
+}
+
 }  // namespace
 }  // namespace diffpills::testing

@@ -42,8 +42,9 @@ bool parallel(const HalfPlane& a, const HalfPlane& b) {
 // angle of their normal are pushed on a deque; before each push, half-planes at either end whose
 // corner with their neighbour lies outside the new one are redundant and dropped. Four box
 // half-planes around the first polygon keep every intermediate region bounded, so that consecutive
-// normals on the deque always turn by less than pi unless the region is empty. Writes the
-// region's vertices, counterclockwise, and returns their number (0: empty).
+// normals on the deque always turn by less than pi unless the region is empty: a turn of pi or
+// more (across the deque's ends too) reports it empty. Writes the region's vertices,
+// counterclockwise, and returns their number (0: empty).
 Eigen::Index intersect(SmallBuffer<HalfPlane, 72>& planes, SmallBuffer<Eigen::Vector2d, 72>& out) {
   std::sort(planes.data(), planes.data() + planes.size(),
             [](const HalfPlane& a, const HalfPlane& b) { return angle_less(a.normal, b.normal); });
@@ -57,7 +58,11 @@ Eigen::Index intersect(SmallBuffer<HalfPlane, 72>& planes, SmallBuffer<Eigen::Ve
     }
     while (tail - head >= 2 && outside(h, meet(deque[tail - 2], deque[tail - 1]))) --tail;
     while (tail - head >= 2 && outside(h, meet(deque[head], deque[head + 1]))) ++head;
-    if (tail > head && parallel(deque[tail - 1], h)) return 0;  // opposite rows met: empty
+    // Opposite rows met, or the normal turned by pi or more: empty.
+    if (tail > head &&
+        (parallel(deque[tail - 1], h) || cross(deque[tail - 1].normal, h.normal) < 0.0)) {
+      return 0;
+    }
     deque[tail++] = h;
   }
   while (tail - head >= 3 && outside(deque[head], meet(deque[tail - 2], deque[tail - 1]))) --tail;
@@ -66,7 +71,7 @@ Eigen::Index intersect(SmallBuffer<HalfPlane, 72>& planes, SmallBuffer<Eigen::Ve
   Eigen::Index count = 0;
   for (Eigen::Index i = head; i < tail; ++i) {
     const HalfPlane& following = i + 1 < tail ? deque[i + 1] : deque[head];
-    if (parallel(deque[i], following)) return 0;
+    if (parallel(deque[i], following) || cross(deque[i].normal, following.normal) < 0.0) return 0;
     out[count++] = meet(deque[i], following);
   }
   return count;
@@ -127,6 +132,13 @@ bool overlap_centre(const HalfPlane* first, Eigen::Index first_count, double fir
   const Eigen::Index count = intersect(planes, vertices);
   if (count == 0) return false;
   centre = region_centre(vertices, count, slack);
+  // The sweep decides by the sides of corners, which rounding can flip where many lines pass near
+  // one point (a polygon far smaller than the scene is a bundle of lines through its origin, found
+  // by fuzz_proximity): the centre must satisfy every half-plane, already grown by slack, to
+  // within slack more, or the polygons are taken not to overlap. O(n), like the sort.
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (planes[j].normal.dot(centre) > planes[j].offset + slack) return false;
+  }
   return true;
 }
 
