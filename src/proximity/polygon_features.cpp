@@ -5,13 +5,6 @@
 
 namespace diffpills::detail {
 
-Segment PolygonView::edge(Eigen::Index j) const {
-  const Eigen::Vector2d start = edge_start(j), direction = edge_direction(j);
-  return {{start.x(), start.y(), 0.0},
-          {direction.x(), direction.y(), 0.0},
-          direction.dot(edge_end(j) - start)};
-}
-
 ClosestFeature face_point(const Eigen::Vector2d& y) {
   ClosestFeature side;
   side.body_point << y, 0.0;

@@ -13,9 +13,35 @@
 
 namespace diffpills::detail {
 
+// What every polygon type derives from its size(), vertex(i) and normal(j) (CRTP): the walk
+// around the boundary and the edges. PolygonView and SubPolygon (sub_polygon.hpp) share it.
+template <class Polygon>
+class PolygonBoundary {
+ public:
+  Eigen::Index previous(Eigen::Index i) const { return i == 0 ? self().size() - 1 : i - 1; }
+  Eigen::Index next(Eigen::Index i) const { return i + 1 == self().size() ? 0 : i + 1; }
+  Eigen::Vector2d edge_start(Eigen::Index j) const { return self().vertex(previous(j)); }
+  Eigen::Vector2d edge_end(Eigen::Index j) const { return self().vertex(j); }
+  // The edge's unit direction, the outward normal turned a quarter counterclockwise.
+  Eigen::Vector2d edge_direction(Eigen::Index j) const {
+    const Eigen::Vector2d n = self().normal(j);
+    return {-n.y(), n.x()};
+  }
+  // Edge j as a segment of the body frame (z = 0), its length without a square root.
+  Segment edge(Eigen::Index j) const {
+    const Eigen::Vector2d start = edge_start(j), direction = edge_direction(j);
+    return {{start.x(), start.y(), 0.0},
+            {direction.x(), direction.y(), 0.0},
+            direction.dot(edge_end(j) - start)};
+  }
+
+ private:
+  const Polygon& self() const { return static_cast<const Polygon&>(*this); }
+};
+
 // A polygon in the units of a query's frame (pair_frame.hpp): every length multiplied by `scale`,
 // a power of two, so exactly. Nothing is copied.
-class PolygonView {
+class PolygonView : public PolygonBoundary<PolygonView> {
  public:
   PolygonView(const PaddedPolygon& polygon, double scale) : polygon_(&polygon), scale_(scale) {}
 
@@ -28,17 +54,6 @@ class PolygonView {
   }
   double offset(Eigen::Index j) const { return scale_ * polygon_->edge_offsets()(j); }
   double extent() const { return scale_ * polygon_->extent(); }
-  Eigen::Index previous(Eigen::Index i) const { return i == 0 ? size() - 1 : i - 1; }
-  Eigen::Index next(Eigen::Index i) const { return i + 1 == size() ? 0 : i + 1; }
-  Eigen::Vector2d edge_start(Eigen::Index j) const { return vertex(previous(j)); }
-  Eigen::Vector2d edge_end(Eigen::Index j) const { return vertex(j); }
-  // The edge's unit direction, the outward normal turned a quarter counterclockwise.
-  Eigen::Vector2d edge_direction(Eigen::Index j) const {
-    const Eigen::Vector2d n = normal(j);
-    return {-n.y(), n.x()};
-  }
-  // Edge j as a segment of the body frame (z = 0), its length without a square root.
-  Segment edge(Eigen::Index j) const;
   // Every edge of the polygon is one of its edges (a SubPolygon also has chords).
   bool is_edge(Eigen::Index) const { return true; }
 

@@ -31,11 +31,4 @@ SubPolygon::SubPolygon(const PolygonView& full, std::vector<Eigen::Index> indice
   }
 }
 
-Segment SubPolygon::edge(Eigen::Index j) const {
-  const Eigen::Vector2d start = edge_start(j), direction = edge_direction(j);
-  return {{start.x(), start.y(), 0.0},
-          {direction.x(), direction.y(), 0.0},
-          direction.dot(edge_end(j) - start)};
-}
-
 }  // namespace diffpills::detail

@@ -12,7 +12,7 @@
 
 namespace diffpills::detail {
 
-class SubPolygon {
+class SubPolygon : public PolygonBoundary<SubPolygon> {
  public:
   // `indices`: at least three of the full polygon's vertex indices, increasing (counterclockwise).
   SubPolygon(const PolygonView& full, std::vector<Eigen::Index> indices);
@@ -21,15 +21,6 @@ class SubPolygon {
   Eigen::Vector2d vertex(Eigen::Index i) const { return full_->vertex(full_index(i)); }
   Eigen::Vector2d normal(Eigen::Index j) const { return normals_[static_cast<std::size_t>(j)]; }
   double offset(Eigen::Index j) const { return offsets_[static_cast<std::size_t>(j)]; }
-  Eigen::Index previous(Eigen::Index i) const { return i == 0 ? size() - 1 : i - 1; }
-  Eigen::Index next(Eigen::Index i) const { return i + 1 == size() ? 0 : i + 1; }
-  Eigen::Vector2d edge_start(Eigen::Index j) const { return vertex(previous(j)); }
-  Eigen::Vector2d edge_end(Eigen::Index j) const { return vertex(j); }
-  Eigen::Vector2d edge_direction(Eigen::Index j) const {
-    const Eigen::Vector2d n = normal(j);
-    return {-n.y(), n.x()};
-  }
-  Segment edge(Eigen::Index j) const;
   // Is edge j (from vertex j - 1 to vertex j) an edge of the full polygon, not a chord?
   bool is_edge(Eigen::Index j) const {
     return full_->next(full_index(previous(j))) == full_index(j);
