@@ -21,10 +21,12 @@ build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DDIFFPILLS_PYTHON=ON -DPython3_EXECUTABLE=$(PYTHON)
 	cmake --build $(BUILD) -j$(JOBS)
 
-# Every test, then the whole suite once more under AddressSanitizer + UndefinedBehaviorSanitizer.
+# Every test, then the whole suite once more under AddressSanitizer + UndefinedBehaviorSanitizer,
+# then each fuzzer for 30 seconds.
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure
 	$(MAKE) test-sanitize
+	$(MAKE) fuzz FUZZ_SECONDS=30
 
 test-sanitize: deps
 	cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDIFFPILLS_SANITIZE=ON \

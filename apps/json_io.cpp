@@ -6,13 +6,16 @@
 namespace diffpills::app {
 namespace {
 
-using json = nlohmann::ordered_json;
+// Queries are read into std::map based objects (see json_line.hpp); answers keep their keys in
+// the documented order.
+using Input = nlohmann::json;
+using Output = nlohmann::ordered_json;
 
 [[noreturn]] void fail(const std::string& field, const std::string& problem) {
   throw std::invalid_argument(field + ": " + problem);
 }
 
-const json& member(const json& object, const std::string& key, const std::string& name) {
+const Input& member(const Input& object, const std::string& key, const std::string& name) {
   const auto it = object.find(key);
   if (it == object.end()) {
     fail(name + "." + key, "missing");
@@ -20,7 +23,7 @@ const json& member(const json& object, const std::string& key, const std::string
   return *it;
 }
 
-double number(const json& value, const std::string& field) {
+double number(const Input& value, const std::string& field) {
   if (!value.is_number()) {
     fail(field, "must be a number");
   }
@@ -28,7 +31,7 @@ double number(const json& value, const std::string& field) {
 }
 
 template <int N>
-Eigen::Matrix<double, N, 1> vector(const json& value, const std::string& field) {
+Eigen::Matrix<double, N, 1> vector(const Input& value, const std::string& field) {
   if (!value.is_array() || value.size() != N) {
     fail(field, "must be an array of " + std::to_string(N) + " numbers");
   }
@@ -39,7 +42,7 @@ Eigen::Matrix<double, N, 1> vector(const json& value, const std::string& field) 
   return out;
 }
 
-void reject_unknown_fields(const json& object, const std::set<std::string>& allowed,
+void reject_unknown_fields(const Input& object, const std::set<std::string>& allowed,
                            const std::string& name) {
   for (const auto& item : object.items()) {
     if (allowed.count(item.key()) == 0) {
@@ -55,7 +58,7 @@ std::string rename_field(const std::string& message, const std::string& owner,
   return message.rfind(owner, 0) == 0 ? name + "." + message.substr(owner.size()) : message;
 }
 
-Shape parse_shape(const json& value, const std::string& name, const std::string& type) {
+Shape parse_shape(const Input& value, const std::string& name, const std::string& type) {
   if (type == "capsule") {
     reject_unknown_fields(value, {"type", "length", "radius", "r", "q"}, name);
     try {
@@ -67,8 +70,8 @@ Shape parse_shape(const json& value, const std::string& name, const std::string&
   }
   if (type == "polygon") {
     reject_unknown_fields(value, {"type", "C", "d", "radius", "r", "q"}, name);
-    const json& rows = member(value, "C", name);
-    const json& offsets = member(value, "d", name);
+    const Input& rows = member(value, "C", name);
+    const Input& offsets = member(value, "d", name);
     if (!rows.is_array()) fail(name + ".C", "must be an array of [c1, c2] rows");
     if (!offsets.is_array()) fail(name + ".d", "must be an array of numbers");
     Eigen::MatrixX2d C(static_cast<Eigen::Index>(rows.size()), 2);
@@ -90,27 +93,27 @@ Shape parse_shape(const json& value, const std::string& name, const std::string&
   fail(name + ".type", "must be \"capsule\" or \"polygon\"");
 }
 
-json rows(const Eigen::MatrixXd& matrix) {
-  json out = json::array();
+Output rows(const Eigen::MatrixXd& matrix) {
+  Output out = Output::array();
   for (Eigen::Index i = 0; i < matrix.rows(); ++i) {
-    json row = json::array();
+    Output row = Output::array();
     for (Eigen::Index j = 0; j < matrix.cols(); ++j) row.push_back(matrix(i, j));
     out.push_back(row);
   }
   return out;
 }
 
-json list(const Eigen::VectorXd& v) {
-  return json(std::vector<double>(v.data(), v.data() + v.size()));
+Output list(const Eigen::VectorXd& v) {
+  return Output(std::vector<double>(v.data(), v.data() + v.size()));
 }
 
 }  // namespace
 
-PosedShape parse_posed_shape(const json& value, const std::string& name) {
+PosedShape parse_posed_shape(const Input& value, const std::string& name) {
   if (!value.is_object()) {
     fail(name, "must be an object");
   }
-  const json& type = member(value, "type", name);
+  const Input& type = member(value, "type", name);
   if (!type.is_string()) {
     fail(name + ".type", "must be \"capsule\" or \"polygon\"");
   }
@@ -124,8 +127,8 @@ PosedShape parse_posed_shape(const json& value, const std::string& name) {
   }
 }
 
-json to_json(const Shape& shape, const Pose& pose) {
-  json out;
+Output to_json(const Shape& shape, const Pose& pose) {
+  Output out;
   if (const auto* capsule = std::get_if<Capsule>(&shape)) {
     out = {{"type", "capsule"}, {"length", capsule->length()}, {"radius", capsule->radius()}};
   } else {
@@ -140,7 +143,7 @@ json to_json(const Shape& shape, const Pose& pose) {
   return out;
 }
 
-json to_json(const Proximity& result) {
+Output to_json(const Proximity& result) {
   return {{"phi", result.phi},
           {"core_points", {list(result.core_points[0]), list(result.core_points[1])}},
           {"points", {list(result.points[0]), list(result.points[1])}},
@@ -149,8 +152,8 @@ json to_json(const Proximity& result) {
           {"cores_intersect", result.cores_intersect}};
 }
 
-json to_json(const ProximityJacobian& result) {
-  json out = to_json(static_cast<const Proximity&>(result));
+Output to_json(const ProximityJacobian& result) {
+  Output out = to_json(static_cast<const Proximity&>(result));
   out["jacobian"] = {{"core_points", rows(result.core_points_jacobian)},
                      {"points", rows(result.points_jacobian)}};
   return out;

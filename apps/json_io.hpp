@@ -15,7 +15,7 @@ struct PosedShape {
   Shape shape;
   Pose pose;
 };
-PosedShape parse_posed_shape(const nlohmann::ordered_json& value, const std::string& name);
+PosedShape parse_posed_shape(const nlohmann::json& value, const std::string& name);
 
 // The same schema back, for output files of the demos.
 nlohmann::ordered_json to_json(const Shape& shape, const Pose& pose);

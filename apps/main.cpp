@@ -1,5 +1,6 @@
 // The diffpills command: `diffpills query` (JSON Lines) and `diffpills demo`.
-#include <cstring>
+#include <cerrno>
+#include <csignal>
 #include <iostream>
 #include <string>
 
@@ -35,28 +36,59 @@ An answer:
   A line that is not a valid query is answered {"error": "<field>: <what is wrong>"}
   and the following lines are still answered.
 
-exit status: 0 every line answered, 1 some line was an error, 2 the command was misused.
+  Each line is answered as soon as it is read, whatever bytes it holds: a line that is not
+  UTF-8, is nested deeper than 64 arrays and objects, repeats a key in one object or is longer
+  than 64 MiB is answered with an error too. A UTF-8 byte order mark and a CR before the line
+  end are ignored.
+
+exit status:
+  0  every line was answered with a result
+  1  some line was answered with an error
+  2  the command was misused (unknown command, extra arguments)
+  3  reading standard input or writing standard output failed (full disk, closed pipe, ...);
+     a message on standard error says which, and the command stops there
 )";
+
+// Ends a command that wrote to standard output: a write that failed (full disk, closed pipe) is
+// reported and ends the command with kInputOutputFailed.
+int finish_output(int status) {
+  return diffpills::app::flush_standard_output(std::cout, std::cerr)
+             ? status
+             : diffpills::app::kInputOutputFailed;
+}
+
+int misuse(const std::string& problem) {
+  std::cerr << "diffpills: " << problem << "\n\n" << kHelp;
+  return diffpills::app::kMisuse;
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) {
+  // A reader that goes away (`diffpills query | head -n 1`) makes writes fail with EPIPE, reported
+  // like any failed write, instead of killing the command silently with SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
+  if (argc < 2) return misuse("missing command");
+  const std::string command = argv[1];
+  if (argc > 2) {
+    return misuse("unexpected argument '" + std::string(argv[2]) + "' after '" + command + "'" +
+                  (command == "query" ? " (queries are read from standard input)" : ""));
+  }
+  errno = 0;  // so that a failed write's reason is its own
+  if (command == "--help" || command == "-h") {
     std::cout << kHelp;
-    return 0;
+    return finish_output(0);
   }
-  if (argc == 2 && std::strcmp(argv[1], "--version") == 0) {
+  if (command == "--version") {
     std::cout << "diffpills " << diffpills::kVersion << "\n";
-    return 0;
+    return finish_output(0);
   }
-  if (argc == 2 && std::strcmp(argv[1], "query") == 0) {
+  if (command == "query") {
     std::ios::sync_with_stdio(false);
     return diffpills::app::run_query(std::cin, std::cout);
   }
-  if (argc == 2 && std::strcmp(argv[1], "demo") == 0) {
-    return diffpills::app::run_scene_demo(std::cout);
+  if (command == "demo") {
+    return finish_output(diffpills::app::run_scene_demo(std::cout));
   }
-  std::cerr << "diffpills: " << (argc < 2 ? "missing command" : "unknown arguments") << "\n\n"
-            << kHelp;
-  return 2;
+  return misuse("unknown command '" + command + "'");
 }

@@ -3,13 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <ios>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <streambuf>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "diffpills/diffpills.hpp"
 #include "json_io.hpp"
+#include "json_line.hpp"
 #include "query.hpp"
 
 namespace diffpills::app {
@@ -23,6 +27,7 @@ const char* kPolygon =
     R"({"type": "polygon", "C": [[1,0],[0,1],[-1,0],[0,-1]], "d": [1,1,1,1], "radius": 0.1, )"
     R"("r": [0.3, 0.1, 1], "q": [0.9, 0.1, 0.2, 0]})";
 
+// Parses an answer strictly: nlohmann::json::parse throws on bytes that are not UTF-8.
 json answer(const std::string& line, bool expect_ok = true) {
   bool ok = false;
   const std::string out = answer_query_line(line, ok);
@@ -30,6 +35,14 @@ json answer(const std::string& line, bool expect_ok = true) {
   EXPECT_EQ(out.find('\n'), std::string::npos);  // one line per answer
   return json::parse(out);
 }
+
+std::string error_of(const std::string& line) {
+  const json out = answer(line, false);
+  EXPECT_EQ(out.size(), 1u) << out;
+  return out.value("error", std::string());
+}
+
+bool mentions_nan(const std::string& message) { return message.find("NaN") != std::string::npos; }
 
 // The error must name `field` at the start of its message.
 void expect_error(const std::string& line, const std::string& field) {
@@ -74,7 +87,7 @@ TEST(Cli, AnswerMatchesTheLibrary) {
 }
 
 TEST(Cli, BadInputGetsAnErrorNamingTheField) {
-  expect_error("{\"a\": ", "malformed JSON");
+  expect_error("{\"a\": ", "a: malformed JSON");  // the value of "a" is missing
   expect_error("[1, 2]", "query");
   expect_error(R"({"a": {}})", "b");
   expect_error(query_with(R"({"type": "cube"})", kPolygon), "a.type");
@@ -89,9 +102,9 @@ TEST(Cli, BadInputGetsAnErrorNamingTheField) {
   };
   expect_error(query_with(capsule("-1", "0.1"), kPolygon), "a.length");
   expect_error(query_with(kPolygon, capsule("1", "-0.1")), "b.radius");
-  expect_error(query_with(capsule("1e999", "0.1"), kPolygon), "malformed JSON");  // not a double
-  expect_error(query_with(capsule("NaN", "0.1"), kPolygon), "malformed JSON");    // not JSON
-  expect_error(query_with(capsule("1e300", "0.1"), kPolygon), "a.length");        // > 1e100
+  expect_error(query_with(capsule("1e999", "0.1"), kPolygon), "a.length: malformed");  // > double
+  expect_error(query_with(capsule("NaN", "0.1"), kPolygon), "a.length: malformed");    // not JSON
+  expect_error(query_with(capsule("1e300", "0.1"), kPolygon), "a.length");             // > 1e100
   expect_error(query_with(capsule("\"1\"", "0.1"), kPolygon), "a.length");
   expect_error(query_with(capsule("1", "0.1", "[0,0]"), kPolygon), "a.r");
   expect_error(query_with(capsule("1", "0.1", "[0,1e101,0]"), kPolygon), "a.r[1]");
@@ -183,6 +196,202 @@ TEST(Cli, DegenerateCasesMatchTheLibrary) {
       }
     }
   }
+}
+
+// Whatever bytes a line holds, its answer is one line of valid UTF-8 JSON: an error naming the
+// field where there is one. Before, bytes that are not UTF-8 made nlohmann's dump() throw while
+// the error answer was built, and the command died in std::terminate.
+TEST(Cli, AnyBytesGetOneValidJsonErrorLine) {
+  std::string every_byte_but_newline;
+  for (int byte = 0; byte < 256; ++byte) {
+    if (byte != '\n') every_byte_but_newline += static_cast<char>(byte);
+  }
+  const std::vector<std::pair<std::string, std::string>> lines_and_fields = {
+      {"{\"a\": \"\xff\"}", "a"},                                  // not UTF-8, in a string
+      {query_with(kCapsule, "\"\xe2\x82\"") + " ", "b"},           // a truncated sequence
+      {"{\"\xc3\x28\": 1}", "query"},                              // not UTF-8, in a key
+      {"\xfe\xff{}", "query"},                                     // not UTF-8, outside strings
+      {"{\"a\": \"\\ud800\"}", "a"},                               // a lone surrogate escape
+      {std::string("{\"a\": 1}\0{\"b\": 2}", 17), "query"},        // a NUL byte
+      {std::string("{\"a\": \"\0\"}", 10), "query"},               // a NUL byte in a string
+      {every_byte_but_newline, "query"},                           // binary garbage
+      {"{\"a\": \"" + std::string(1000000, 'x') + "\xff\"}", "a"}  // a long token quoted
+  };
+  for (const auto& [line, field] : lines_and_fields) {
+    const std::string error = error_of(line);
+    EXPECT_EQ(error.rfind(field + ": ", 0), 0u) << error;
+    EXPECT_LT(error.size(), 2000u);  // an error does not echo a megabyte of query
+  }
+  // The replacement character stands for the bytes that are not UTF-8.
+  EXPECT_NE(error_of("{\"a\": \"\xff\"}").find("\xef\xbf\xbd"), std::string::npos);
+}
+
+// A byte order mark at the start of a line, and CR LF line ends, are whitespace: the query is
+// answered. A line of nothing but whitespace is an error that says the line is empty.
+TEST(Cli, ByteOrderMarkAndCarriageReturnAreIgnored) {
+  const json with_bom = answer("\xef\xbb\xbf" + query_with(kCapsule, kPolygon));
+  const json with_cr = answer(query_with(kCapsule, kPolygon) + "\r");
+  const json plain = answer(query_with(kCapsule, kPolygon));
+  EXPECT_EQ(with_bom, plain);
+  EXPECT_EQ(with_cr, plain);
+  for (const std::string blank : {"", "   ", "\t \r", "\xef\xbb\xbf"}) {
+    const std::string error = error_of(blank);
+    EXPECT_EQ(error.rfind("query: empty line", 0), 0u) << error;
+  }
+  EXPECT_EQ(error_of("\xef\xbb").rfind("query: malformed JSON", 0), 0u);  // half a BOM
+}
+
+// nlohmann's parser builds arrays and objects without recursion, but copying a value is
+// recursive: before, 10^5 arrays nested inside an object with a sibling key overflowed the stack
+// (the ordered_json object copied its members when it grew). Lines nested deeper than
+// kMaxNesting are now rejected while they are parsed, naming where.
+TEST(Cli, DeepNestingIsRejectedNotACrash) {
+  const std::size_t deep = 1000000;
+  const std::string arrays = std::string(deep, '[') + std::string(deep, ']');
+  std::string objects;
+  for (std::size_t i = 0; i < deep; ++i) objects += "{\"a\":";
+  objects += "1" + std::string(deep, '}');
+  const std::string in_a_shape =
+      R"({"a": {"type": "capsule", "length": )" + arrays + "}, " + R"("b": {"type": "capsule"}})";
+  for (const std::string& line : {arrays, objects, in_a_shape, std::string(deep, '[')}) {
+    const std::string error = error_of(line);
+    EXPECT_NE(error.find("nested deeper than 64"), std::string::npos) << error.substr(0, 200);
+  }
+  EXPECT_EQ(error_of(in_a_shape).rfind("a.length[0][0]", 0), 0u);
+  EXPECT_EQ(error_of(objects).rfind("a.a.a.a", 0), 0u);
+  // Exactly kMaxNesting levels parse (and are then no query).
+  const std::string deepest = std::string(kMaxNesting, '[') + std::string(kMaxNesting, ']');
+  EXPECT_EQ(error_of(deepest).rfind("query: must be a JSON object", 0), 0u);
+}
+
+// A syntax error says what is wrong and where (nlohmann's reason, the byte), and mentions NaN and
+// Infinity only when the line holds such a word or a number out of a double's range.
+TEST(Cli, SyntaxErrorsSayWhatIsWrong) {
+  const std::string trailing_comma = error_of(R"({"a": 1,})");
+  EXPECT_EQ(trailing_comma.rfind("query: malformed JSON at byte 9: ", 0), 0u) << trailing_comma;
+  EXPECT_NE(trailing_comma.find("expected string literal"), std::string::npos);
+  EXPECT_FALSE(mentions_nan(trailing_comma));
+  EXPECT_FALSE(mentions_nan(error_of("not json")));
+  EXPECT_FALSE(mentions_nan(error_of(R"({"a": "nan", "inf": 1,})")));  // words inside strings
+  EXPECT_FALSE(mentions_nan(error_of(query_with(kCapsule, kPolygon) + "}")));
+  const auto capsule_r = [](const std::string& r) {
+    return query_with(
+        R"({"type": "capsule", "length": 1, "radius": 0.1, "q": [1,0,0,0], "r": )" + r + "}",
+        kPolygon);
+  };
+  for (const std::string number : {"NaN", "nan", "-Infinity", "inf", "+inf", "1e999", "-1e400"}) {
+    const std::string error = error_of(capsule_r("[0, " + number + ", 0]"));
+    EXPECT_EQ(error.rfind("a.r[1]: malformed JSON at byte ", 0), 0u) << error;
+    EXPECT_TRUE(mentions_nan(error)) << error;
+  }
+  const std::string big_integer = "1" + std::string(400, '0');  // JSON, but no double holds it
+  EXPECT_EQ(error_of(capsule_r("[0, 0, " + big_integer + "]")).rfind("a.r[2]: malformed", 0), 0u);
+  // Numbers a double holds are numbers, whatever their spelling.
+  EXPECT_EQ(answer(capsule_r("[-0, 0.0, 1E-400]"))["phi"], answer(capsule_r("[0, 0, 0]"))["phi"]);
+  EXPECT_EQ(answer(capsule_r("[0, 0, 12345678901234567890123]"))["cores_intersect"], false);
+}
+
+// JSON that parses but is no query: each error names the field.
+TEST(Cli, HostileButWellFormedQueries) {
+  // nlohmann would keep the last of two equal keys; a query that says two things is an error.
+  expect_error(R"({"a": 1, "b": 2, "a": 3})", "a: given twice");
+  expect_error(query_with(R"({"type": "capsule", "length": 1, "radius": 0.1, "r": [0,0,0],
+                              "q": [1,0,0,0], "r": [1,1,1]})",
+                          kPolygon),
+               "a.r: given twice");
+  expect_error(query_with(kCapsule, kPolygon, R"(, "jacobian": true, "jacobian": false)"),
+               "jacobian: given twice");
+  // Sizes, types and values.
+  const auto capsule = [](const std::string& fields) {
+    return query_with(R"({"type": "capsule", )" + fields + "}", kPolygon);
+  };
+  expect_error(capsule(R"("length": 1, "radius": 0.1, "r": [0,0,0], "q": [1,0,0,0,0])"), "a.q");
+  expect_error(capsule(R"("length": 1, "radius": "0.1", "r": [0,0,0], "q": [1,0,0,0])"),
+               "a.radius");
+  expect_error(capsule(R"("length": 1, "radius": 0.1, "r": [0,"0",0], "q": [1,0,0,0])"), "a.r[1]");
+  expect_error(capsule(R"("length": 1, "radius": 0.1, "r": [0,null,0], "q": [1,0,0,0])"), "a.r[1]");
+  expect_error(capsule(R"("length": [1], "radius": 0.1, "r": [0,0,0], "q": [1,0,0,0])"),
+               "a.length");
+  expect_error(query_with(kCapsule, kPolygon, R"(, "method": 1)"), "method");
+  expect_error("{} {}", "query: malformed JSON");
+  expect_error("\"a\"", "query: must be a JSON object");
+  // A large polygon, given as JSON: answered, the same as through the library.
+  const int vertices = 100000;
+  Eigen::MatrixX2d C(vertices, 2);
+  for (int k = 0; k < vertices; ++k) {
+    C.row(k) << std::cos(2 * M_PI * k / vertices), std::sin(2 * M_PI * k / vertices);
+  }
+  const PaddedPolygon polygon(C, Eigen::VectorXd::Ones(vertices), 0.1);
+  const Pose pose({0.2, 0.1, 1.5}, {0.9, 0.1, 0.2, 0});
+  json query;
+  query["a"] = to_json(Shape(polygon), Pose());
+  query["b"] = to_json(Shape(polygon), pose);
+  const json out = answer(query.dump());
+  EXPECT_EQ(out["phi"].get<double>(), proximity(polygon, Pose(), polygon, pose).phi);
+}
+
+// Lines up to kMaxLineBytes are answered; a longer line is answered with an error without being
+// kept whole, and the next line is answered.
+TEST(Cli, OverlongLineIsAnErrorAndTheNextLineIsAnswered) {
+  std::string longest = query_with(kCapsule, kPolygon);
+  longest.resize(kMaxLineBytes, ' ');
+  std::istringstream in(longest + "\n" + longest + " \n" + query_with(kCapsule, kCapsule));
+  std::ostringstream out;
+  EXPECT_EQ(run_query(in, out), 1);
+  std::istringstream lines(out.str());
+  std::vector<json> answers;
+  for (std::string line; std::getline(lines, line);) answers.push_back(json::parse(line));
+  ASSERT_EQ(answers.size(), 3u);
+  EXPECT_TRUE(answers[0].contains("phi"));
+  EXPECT_EQ(answers[1]["error"].get<std::string>().rfind("query: line longer than", 0), 0u);
+  EXPECT_TRUE(answers[2].contains("phi"));
+}
+
+// An output whose every write fails, like a full disk or a closed pipe.
+class FailingOutput : public std::streambuf {
+ protected:
+  int_type overflow(int_type /*c*/) override { return traits_type::eof(); }
+};
+
+// An input that serves `text`, then fails like libstdc++'s file buffers on a read error.
+class FailingInput : public std::streambuf {
+ public:
+  explicit FailingInput(std::string text) : text_(std::move(text)) {
+    setg(text_.data(), text_.data(), text_.data() + text_.size());
+  }
+
+ protected:
+  int_type underflow() override { throw std::ios_base::failure("read error"); }
+
+ private:
+  std::string text_;
+};
+
+// Before, a failed write was ignored: the command answered nothing and exited 0.
+TEST(Cli, FailedWriteEndsTheCommandWithStatus3) {
+  std::istringstream in(query_with(kCapsule, kCapsule) + "\n" + query_with(kCapsule, kPolygon) +
+                        "\n");
+  FailingOutput failing;
+  std::ostream out(&failing);
+  std::ostringstream diagnostics;
+  EXPECT_EQ(run_query(in, out, diagnostics), 3);
+  EXPECT_EQ(diagnostics.str().rfind("diffpills: cannot write to standard output", 0), 0u)
+      << diagnostics.str();
+  // It stopped at the first failed answer: the second line was not read.
+  std::string unread;
+  EXPECT_TRUE(std::getline(in, unread));
+  EXPECT_EQ(unread, query_with(kCapsule, kPolygon));
+}
+
+TEST(Cli, FailedReadEndsTheCommandWithStatus3) {
+  FailingInput failing(query_with(kCapsule, kCapsule) + "\n");
+  std::istream in(&failing);
+  std::ostringstream out;
+  std::ostringstream diagnostics;
+  EXPECT_EQ(run_query(in, out, diagnostics), 3);
+  EXPECT_NE(out.str().find("\"phi\""), std::string::npos);  // the line before was answered
+  EXPECT_EQ(diagnostics.str().rfind("diffpills: cannot read standard input", 0), 0u)
+      << diagnostics.str();
 }
 
 }  // namespace

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# The diffpills binary on hostile standard input: whatever bytes a line holds, it gets exactly one
+# answer line of valid UTF-8 JSON, in order, and the process survives to answer the next lines.
+set -uo pipefail
+bin="$1"
+query='{"a": {"type": "capsule", "length": 2, "radius": 0.2, "r": [0,0,0], "q": [1,0,0,0]}, "b": {"type": "capsule", "length": 1, "radius": 0.1, "r": [0,0,1], "q": [1,0,0,0]}}'
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fail() { echo "cli hostile input: $*"; exit 1; }
+
+# Checks that file $1 holds one answer per expected kind listed in $2 ("r" result, "e" error):
+# strict UTF-8, each line a JSON object (no NaN), an "error" string alone or a finite "phi".
+check_answers() {
+  python3 - "$1" "$2" <<'EOF' || exit 1
+import json, math, sys
+def reject(token):
+    raise ValueError("not JSON: " + token)
+lines = open(sys.argv[1], "rb").read().decode("utf-8").split("\n")  # strict: raises on bad bytes
+assert lines[-1] == "", "the output must end with a newline"
+kinds = sys.argv[2]
+assert len(lines) - 1 == len(kinds), f"{len(lines) - 1} answers for {len(kinds)} lines"
+for number, (line, kind) in enumerate(zip(lines, kinds), 1):
+    answer = json.loads(line, parse_constant=reject)
+    if kind == "e":
+        assert list(answer) == ["error"] and isinstance(answer["error"], str), (number, line[:200])
+    else:
+        assert "phi" in answer and math.isfinite(answer["phi"]), (number, line[:200])
+EOF
+}
+
+# Every kind of line at once, each followed by a valid query that must still be answered.
+{
+  printf '{"a": "\xff"}\n%s\n' "$query"                    # invalid UTF-8 in a string
+  printf '{"\xc3\x28": 1}\n%s\n' "$query"                  # ... in a key
+  printf '\xfe\xff{}\xc0\n%s\n' "$query"                   # ... outside strings
+  printf '{"a": 1}\0{"b": 2}\n%s\n' "$query"               # a NUL byte
+  printf '{"a": "\\ud800"}\n%s\n' "$query"                  # a lone surrogate escape
+  python3 -c "import sys; sys.stdout.buffer.write(bytes(b for b in range(256) if b != 10) * 16)"
+  printf '\n%s\n' "$query"                                   # every byte but '\n': binary garbage
+  head -c 1000000 /dev/zero | tr '\0' '['; printf '\n%s\n' "$query"  # 10^6 nested arrays
+  python3 -c "print('{\"a\":' * 100000 + '1' + '}' * 100000)"; printf '%s\n' "$query"
+  printf '{"a": "%s\xff"}\n%s\n' "$(head -c 3000000 /dev/zero | tr '\0' 'x')" "$query"  # 3 MB
+  printf '\xef\xbb\xbf%s\r\n' "$query"                      # a BOM and CR LF: a valid query
+} > "$work/in"
+"$bin" query < "$work/in" > "$work/out"
+status=$?
+[ "$status" -eq 1 ] || fail "exit $status, expected 1 (some lines are errors)"
+check_answers "$work/out" "$(printf 'er%.0s' {1..9})r"
+
+# The error of a long line quoting its bad bytes stays short.
+[ "$(sed -n 17p "$work/out" | wc -c)" -lt 2000 ] || fail "the error of a 3 MB line is not short"
+# An object of 10^6 keys is answered in about a second. Keyed in insertion order (ordered_json:
+# a linear search per key) it took O(n^2), minutes; the timeout is far from both.
+python3 -c "print('{' + ','.join('\"k%d\": 1' % i for i in range(1000000)) + '}')" > "$work/keys"
+timeout 120 "$bin" query < "$work/keys" > "$work/out"
+status=$?
+[ "$status" -eq 1 ] || fail "10^6 keys: exit $status, expected 1 within 120 s"
+check_answers "$work/out" e
+echo "cli hostile input: ok"
