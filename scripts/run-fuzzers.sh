@@ -14,7 +14,7 @@ for target in fuzz_query fuzz_proximity; do
   mkdir -p "$corpus" "$artifacts"
   log="$build/$target.log"
   echo "fuzz: $target for ${seconds}s"
-  if ! "$build/fuzz/$target" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=4096 \
+  if ! "$build/fuzz/$target" -max_total_time="$seconds" -timeout=60 -rss_limit_mb=4096 \
       -max_len=4096 -print_final_stats=1 -artifact_prefix="$artifacts" \
       "$corpus" "$root/fuzz/corpus/$target" > "$log" 2>&1; then
     echo "fuzz: $target FAILED; input saved in $artifacts, log $log:"
