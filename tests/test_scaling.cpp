@@ -261,7 +261,11 @@ TEST(Scaling, CoplanarSpeckBesideAHugePolygon) {
   // The fuzzer's poses: half turns about z and (nearly) y, so that the planes are parallel and
   // the speck's shadow is mirrored and skewed by 4e-9.
   const Pose pose_huge({1e70, 1e70, 0}, Eigen::Vector4d(1.398e-76, 1.398e-76, 0, -2.875));
-  const Pose pose_speck({3, 0, 1.398e-76}, Eigen::Vector4d(9e-308, 1.398e-76, 7.522e-68, 3.66e-86));
+  // (The fuzzer's quaternion had norm 7.5e-68, below today's minimum; 2^100 times it normalizes to
+  // the same unit quaternion, bit for bit.)
+  const Pose pose_speck(
+      {3, 0, 1.398e-76},
+      std::ldexp(1.0, 100) * Eigen::Vector4d(9e-308, 1.398e-76, 7.522e-68, 3.66e-86));
   const Proximity ab = proximity(huge, pose_huge, speck, pose_speck);
   const Proximity ba = proximity(speck, pose_speck, huge, pose_huge);
   EXPECT_FALSE(ab.cores_intersect);
@@ -275,6 +279,30 @@ TEST(Scaling, CoplanarSpeckBesideAHugePolygon) {
   EXPECT_LE((ab.core_points[0] - pose_huge.r()).norm(), 1e70 / std::cos(M_PI / 51) * (1 + 1e-12));
   EXPECT_GE((ab.core_points[0] - ab.core_points[1]).norm(),
             centre_distance - 1e70 / std::cos(M_PI / 51) * (1 + 1e-12));
+}
+
+// The smallest accepted quaternion norm in the largest accepted scene: derivatives with respect to
+// q carry 1 / |q|, and stay finite (fuzz_proximity found an infinite gradient with |q| = 2e-146
+// and lengths near 1e100, then accepted).
+TEST(Scaling, SmallestQuaternionInTheLargestScene) {
+  Eigen::MatrixX2d C(50, 2);
+  for (int k = 0; k < 50; ++k) C.row(k) << std::cos(2 * M_PI * k / 50), std::sin(2 * M_PI * k / 50);
+  const std::vector<Shape> shapes = {
+      PaddedPolygon(C, Eigen::VectorXd::Constant(50, 0.99e100), 1e100), Capsule(1e100, 1e100)};
+  const double smallest = 1.0000001e-40;  // just above the smallest accepted norm
+  const Eigen::Vector4d tiny_q = smallest * Eigen::Vector4d(0.5, -0.5, 0.5, 0.5);
+  const Pose far({-1e100, 1e100, -1e100}, tiny_q);
+  const Pose near({1e100, -1e100, 1e100},
+                  Eigen::Vector4d(0.3, 0.1, -0.2, 0.9).normalized() * smallest);
+  for (const Shape& a : shapes) {
+    for (const Shape& b : shapes) {
+      const ProximityJacobian result = proximity_jacobian(a, far, b, near);
+      EXPECT_TRUE(std::isfinite(result.phi));
+      EXPECT_TRUE(result.gradient.allFinite());
+      EXPECT_TRUE(result.points_jacobian.allFinite());
+      EXPECT_GT(result.gradient.segment<4>(3).norm(), 1e200);  // large, as it must be
+    }
+  }
 }
 
 }  // namespace

@@ -115,7 +115,9 @@ TEST(Shapes, PoseRejectsBadNumbers) {
   expect_invalid([] { Pose({0, 0, 0}, {1, kInf, 0, 0}); }, "pose.q[1]");
   expect_invalid([] { Pose({0, 0, 0}, {0, 0, 0, 0}); }, "pose.q");
   expect_invalid([] { Pose({0, 0, 0}, {1e-170, 0, 0, 0}); }, "pose.q");
-  EXPECT_NO_THROW(Pose({0, 0, 0}, {1e-100, 0, 0, 0}));
+  expect_invalid([] { Pose({0, 0, 0}, {-1.1e-146, -1.1e-146, -1.1e-146, -1.1e-146}); }, "pose.q");
+  expect_invalid([] { Pose({0, 0, 0}, {0, 0, 9e-41, 0}); }, "pose.q");
+  EXPECT_NO_THROW(Pose({0, 0, 0}, {1e-40, 0, 0, 0}));
 }
 
 TEST(Shapes, PolygonRejectsBadRows) {

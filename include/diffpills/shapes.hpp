@@ -81,8 +81,9 @@ class Pose {
   // The identity pose.
   Pose();
   // Throws std::invalid_argument ("pose.r: ...", "pose.q: ...") for non-finite entries, |entries|
-  // above kMaxMagnitude, or a quaternion whose norm is zero (below 1e-150, where its square
-  // underflows and no direction can be recovered).
+  // above kMaxMagnitude, or a quaternion whose norm is zero or below 1e-40 (derivatives with
+  // respect to q grow as 1 / |q|; below that bound they could overflow for the largest accepted
+  // scenes).
   Pose(const Eigen::Vector3d& r, const Eigen::Vector4d& q);
 
   const Eigen::Vector3d& r() const { return r_; }

@@ -307,5 +307,8 @@ def test_extreme_but_valid_input_gives_finite_results():
     capsule = diffpills.Capsule(1e-9, 1e-9)
     polygon = diffpills.PaddedPolygon(SQUARE_C * 1e6, [1e6] * 4, 0.0)
     for r in ([1e8, 0.0, 0.0], [0.0, 0.0, 1e-12], [0.0, 0.0, 0.0]):
-        result = diffpills.proximity(capsule, diffpills.Pose(r, [1e-100, 0.0, 1e-100, 0.0]), polygon, diffpills.Pose())
+        result = diffpills.proximity(capsule, diffpills.Pose(r, [1e-40, 0.0, 1e-40, 0.0]), polygon, diffpills.Pose())
         assert np.isfinite(result.phi) and np.all(np.isfinite(result.gradient))
+    # Below a norm of 1e-40 the gradient's 1 / |q| could overflow: refused.
+    with pytest.raises(ValueError, match="pose.q"):
+        diffpills.Pose([0.0, 0.0, 0.0], [1e-100, 0.0, 1e-100, 0.0])
