@@ -9,4 +9,5 @@
 #include "diffpills/qp/interior_point.hpp"
 #include "diffpills/rotation.hpp"
 #include "diffpills/shapes.hpp"
+#include "diffpills/signed_distance.hpp"
 #include "diffpills/version.hpp"

@@ -8,10 +8,10 @@
 #include <utility>
 #include <variant>
 
-#include "fast_paths.hpp"
 #include "pair_frame.hpp"
 #include "pair_problem.hpp"
 #include "pair_result.hpp"
+#include "pair_setup.hpp"
 #include "pair_solve.hpp"
 #include "parametric_core.hpp"
 #include "polygon_features.hpp"
@@ -20,44 +20,10 @@
 namespace diffpills {
 namespace {
 
-using detail::ClosestFeature;
 using detail::PairFrame;
 using detail::PolygonView;
 using detail::PosedCore;
-using Sides = std::array<ClosestFeature, 2>;
-
-double core_size(const Capsule& capsule) { return capsule.length(); }
-double core_size(const PaddedPolygon& polygon) { return polygon.extent(); }
-
-// The shape's core in the frame: origin moved to `origin`, lengths divided by the frame's scale
-// (multiplied by its exact inverse).
-template <class Shape>
-PosedCore posed_core(const Shape& shape, const Pose& pose, const Eigen::Vector3d& origin,
-                     const PairFrame& frame) {
-  return {(pose.r() - origin) * frame.inverse_scale, detail::UnitQuaternion(pose.q()),
-          shape.radius() * frame.inverse_scale, core_size(shape) * frame.inverse_scale};
-}
-
-Sides fast_sides(const Capsule&, const PosedCore& pa, const Capsule&, const PosedCore& pb,
-                 const PairFrame&) {
-  return detail::solve_capsule_capsule(pa, pb);
-}
-Sides fast_sides(const Capsule&, const PosedCore& pa, const PaddedPolygon& b, const PosedCore& pb,
-                 const PairFrame& frame) {
-  return detail::solve_capsule_polygon(pa, PolygonView(b, frame.inverse_scale), pb,
-                                       frame.tolerance);
-}
-Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Capsule&, const PosedCore& pb,
-                 const PairFrame& frame) {
-  const Sides swapped =
-      detail::solve_capsule_polygon(pb, PolygonView(a, frame.inverse_scale), pa, frame.tolerance);
-  return {swapped[1], swapped[0]};
-}
-Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const PaddedPolygon& b,
-                 const PosedCore& pb, const PairFrame& frame) {
-  return detail::solve_polygon_polygon(PolygonView(a, frame.inverse_scale), pa,
-                                       PolygonView(b, frame.inverse_scale), pb, frame.tolerance);
-}
+using detail::Sides;
 
 detail::ParametricCore parametric_core(const Capsule&, const PosedCore& posed, const PairFrame&) {
   return detail::make_parametric_capsule(posed.size);
@@ -80,13 +46,13 @@ Sides reference_sides(const ShapeA& a, const PosedCore& pa, const ShapeB& b, con
 template <class Result, class ShapeA, class ShapeB>
 Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& pose_b,
              const ProximityOptions& options) {
-  const PairFrame frame = detail::make_pair_frame(core_size(a), a.radius(), core_size(b),
-                                                  b.radius(), pose_a.r(), pose_b.r());
-  const PosedCore posed_a = posed_core(a, pose_a, pose_a.r(), frame);
-  const PosedCore posed_b = posed_core(b, pose_b, pose_a.r(), frame);
+  const PairFrame frame = detail::make_pair_frame(
+      detail::core_size(a), a.radius(), detail::core_size(b), b.radius(), pose_a.r(), pose_b.r());
+  const PosedCore posed_a = detail::posed_core(a, pose_a, pose_a.r(), frame);
+  const PosedCore posed_b = detail::posed_core(b, pose_b, pose_a.r(), frame);
   const Sides sides = options.method == Method::kInteriorPoint
                           ? reference_sides(a, posed_a, b, posed_b, frame)
-                          : fast_sides(a, posed_a, b, posed_b, frame);
+                          : detail::fast_sides(a, posed_a, b, posed_b, frame);
   if constexpr (std::is_same_v<Result, ProximityJacobian>) {
     return detail::make_proximity_jacobian(frame, pose_a, posed_a, sides[0], pose_b, posed_b,
                                            sides[1]);

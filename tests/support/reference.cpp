@@ -119,4 +119,40 @@ ClosestPair brute_force_closest(const WorldCore& a, const WorldCore& b) {
   return best;
 }
 
+SignedCoreDistance brute_force_signed_distance(const WorldCore& a, const WorldCore& b,
+                                               long double scale) {
+  const ClosestPair closest = brute_force_closest(a, b);
+  if (closest.distance > 1e-10L * scale) {
+    return {closest.distance, (closest.p2 - closest.p1) / closest.distance};
+  }
+  std::vector<Vec3L> w;
+  for (const auto& va : a.vertices) {
+    for (const auto& vb : b.vertices) w.push_back(va - vb);
+  }
+  const long double slack = 1e-12L * scale;
+  SignedCoreDistance best{std::numeric_limits<long double>::infinity(), Vec3L::Zero()};
+  const std::size_t n = w.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      for (std::size_t k = j + 1; k < n; ++k) {
+        Vec3L normal = (w[j] - w[i]).cross(w[k] - w[i]);
+        const long double length = normal.norm();
+        if (length <= 1e-9L * scale * scale) continue;  // (nearly) collinear points
+        normal /= length;
+        const long double offset = normal.dot(w[i]);
+        long double low = offset, high = offset;
+        for (const auto& x : w) {
+          low = std::min(low, normal.dot(x));
+          high = std::max(high, normal.dot(x));
+        }
+        // A supporting plane: the outward normal points away from the points' side.
+        if (high <= offset + slack && offset < best.s) best = {offset, normal};
+        if (low >= offset - slack && -offset < best.s) best = {-offset, -normal};
+      }
+    }
+  }
+  if (best.s == std::numeric_limits<long double>::infinity()) return {0, Vec3L::Zero()};
+  return {-best.s, best.normal};
+}
+
 }  // namespace diffpills::testing

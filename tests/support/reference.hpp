@@ -24,4 +24,17 @@ struct ClosestPair {
 
 ClosestPair brute_force_closest(const WorldCore& a, const WorldCore& b);
 
+// The signed distance of the cores, s = dist(0, D) when the cores are apart and minus the distance
+// from 0 to D's boundary when they intersect, with D = conv{va - vb} the cores' Minkowski
+// difference. Apart: brute_force_closest. Intersecting: every plane through three points of D's
+// vertex set {va - vb} that has all of them on one side is a facet plane of D; the depth is the
+// smallest distance of such a plane from 0 (0 when D is flat or a segment). O(n^4) in the n = na nb
+// vertex differences: for small cores only. `scale` is the scene's length scale (tolerances).
+struct SignedCoreDistance {
+  long double s = 0;
+  Vec3L normal = Vec3L::Zero();  // from core a to core b (zero where D has no facet)
+};
+SignedCoreDistance brute_force_signed_distance(const WorldCore& a, const WorldCore& b,
+                                               long double scale);
+
 }  // namespace diffpills::testing

@@ -1,0 +1,51 @@
+// What every query of a pair does first, shared by the proximity and the signed distance: the
+// cores posed in the pair's frame (pair_frame.hpp) and the exact fast solvers (fast_paths.hpp)
+// chosen by the shapes' types.
+#pragma once
+
+#include <array>
+
+#include "diffpills/shapes.hpp"
+#include "fast_paths.hpp"
+#include "pair_frame.hpp"
+#include "polygon_features.hpp"
+#include "posed_core.hpp"
+
+namespace diffpills::detail {
+
+using Sides = std::array<ClosestFeature, 2>;
+
+inline double core_size(const Capsule& capsule) { return capsule.length(); }
+inline double core_size(const PaddedPolygon& polygon) { return polygon.extent(); }
+
+// The shape's core in the frame: origin moved to `origin`, lengths divided by the frame's scale
+// (multiplied by its exact inverse).
+template <class Shape>
+PosedCore posed_core(const Shape& shape, const Pose& pose, const Eigen::Vector3d& origin,
+                     const PairFrame& frame) {
+  return {(pose.r() - origin) * frame.inverse_scale, detail::UnitQuaternion(pose.q()),
+          shape.radius() * frame.inverse_scale, core_size(shape) * frame.inverse_scale};
+}
+
+inline Sides fast_sides(const Capsule&, const PosedCore& pa, const Capsule&, const PosedCore& pb,
+                        const PairFrame&) {
+  return detail::solve_capsule_capsule(pa, pb);
+}
+inline Sides fast_sides(const Capsule&, const PosedCore& pa, const PaddedPolygon& b,
+                        const PosedCore& pb, const PairFrame& frame) {
+  return detail::solve_capsule_polygon(pa, PolygonView(b, frame.inverse_scale), pb,
+                                       frame.tolerance);
+}
+inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Capsule&,
+                        const PosedCore& pb, const PairFrame& frame) {
+  const Sides swapped =
+      detail::solve_capsule_polygon(pb, PolygonView(a, frame.inverse_scale), pa, frame.tolerance);
+  return {swapped[1], swapped[0]};
+}
+inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const PaddedPolygon& b,
+                        const PosedCore& pb, const PairFrame& frame) {
+  return detail::solve_polygon_polygon(PolygonView(a, frame.inverse_scale), pa,
+                                       PolygonView(b, frame.inverse_scale), pb, frame.tolerance);
+}
+
+}  // namespace diffpills::detail

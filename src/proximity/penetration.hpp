@@ -1,0 +1,67 @@
+// Two intersecting cores: the facet of their Minkowski difference nearest the origin, which gives
+// the signed distance's penetration depth, normal and witness points (signed_distance.hpp).
+//
+// D = K1 - K2 = {x1 - x2 : x1 in K1, x2 in K2} holds 0 when the cores intersect. The translational
+// penetration depth, the shortest translation of K2 after which the cores' interiors are apart,
+// is the distance from 0 to D's boundary:
+//
+//     depth = min over unit n of h_D(n),   h_D(n) = max_{x in D} n . x = h_1(n) + h_2(-n)
+//
+// with h_i the support function of K_i (for every unit n the ray from 0 along n leaves D within
+// h_D(n), and the supporting plane at the nearest boundary point is at exactly that distance). The
+// minimum is taken at the outward normal of D's nearest facet, and D is a polytope whose facets
+// are sums of a face of K1 and a face of -K2 whose normal cones meet, of total dimension 2:
+//   - a polygon's own face plus the other core's support set: n = +-N_i, N_i = Q_i e_z. A polygon
+//     is a face of itself for both signs, so these are facets whenever D has an interior;
+//   - an edge e of K1 plus an edge f of K2, not parallel: n = +-(e x f) / |e x f|, a facet when n
+//     lies in both edges' normal cones. In 3-D a polygon edge's normal cone is
+//     {alpha N + beta o : beta >= 0}, o its outward normal in the polygon's plane, so an edge of
+//     K1 needs n . o >= 0 and an edge of K2 (mirrored in -K2) n . o <= 0; a segment, which is
+//     its own edge, admits every n normal to it. Such a facet's h_D(n) = n . (x_e - x_f) for any
+//     points x_e, x_f of the two edges: the distance between the edges' lines.
+// A vertex plus a vertex or an edge is not 2-D, so there are no other facets. Every candidate's
+// value is h_D at a facet normal, at least the depth, and the nearest facet is among them: their
+// minimum is the depth. The normal-cone tests allow 1e-12 (a cosine, so relative): a candidate
+// admitted within it is below the true h_D(n) by at most 1e-12 of the scene's size.
+//
+// Where D is flat (two segments, a segment lying in a polygon's plane, coplanar polygons) it has
+// no interior; the candidates +-n of its plane then both give 0, the documented depth.
+//
+// Ties (values within the frame's tolerance) go to the normal pointing most from core 1's body
+// origin to core 2's, n . (r2 - r1), which turns with the scene and flips with the order of the
+// shapes; then to the one most along core 1's Q e_z; then to the first found (faces of core 1,
+// faces of core 2, edge pairs in order).
+//
+// Cost: O(m1 m2) for two polygons of m1 and m2 vertices (D has that many edge-edge facets),
+// O(m) for a segment and a polygon; nothing is allocated up to 32 vertices.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+
+#include "core_outline.hpp"
+
+namespace diffpills::detail {
+
+struct DeepestFacet {
+  enum class Kind {
+    kNone,   // no candidate: two parallel segments, or a sphere with a segment or a sphere
+    kFace,   // core face_core's face
+    kEdges,  // edge edges[0] of core 1 and edges[1] of core 2
+  };
+  Kind kind = Kind::kNone;
+  double depth = 0.0;                                // h_D(normal), in the frame's units
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, outward from D: from core 1 to core 2
+  int face_core = 0;
+  std::array<Eigen::Index, 2> edges = {0, 0};
+};
+
+DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double tolerance);
+
+// Points x1 of core 1 and x2 of core 2 on the facet with x1 - x2 = depth * normal: the point of
+// D's facet nearest the origin, split into its two cores (the middle of the set of such pairs
+// when it is not one pair: the middle of an edge's part over a face). Only for kFace and kEdges.
+std::array<ClosestFeature, 2> facet_witnesses(const DeepestFacet& facet, const CoreOutline& a,
+                                              const CoreOutline& b, double tolerance);
+
+}  // namespace diffpills::detail

@@ -1,0 +1,184 @@
+// The public signed-distance queries (signed_distance.hpp). Each solves the closest-point problem
+// with the proximity's exact fast path (pair_setup.hpp); cores apart by more than the frame's
+// tolerance are done then. Intersecting cores go on to the nearest facet of their Minkowski
+// difference (penetration.hpp), whose witnesses replace the closest points unless the facet is
+// within the tolerance of the origin (touching, or a flat D), where the closest points, the
+// middle of the cores' intersection, serve as they are.
+#include "diffpills/signed_distance.hpp"
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <type_traits>
+#include <variant>
+
+#include "core_outline.hpp"
+#include "pair_frame.hpp"
+#include "pair_setup.hpp"
+#include "penetration.hpp"
+#include "signed_distance_result.hpp"
+
+namespace diffpills {
+namespace {
+
+using detail::CoreOutline;
+using detail::DeepestFacet;
+using detail::NormalSource;
+using detail::PairFrame;
+using detail::PolygonView;
+using detail::PosedCore;
+using detail::SignedSolution;
+
+// The normal where D has no facet (parallel segments, spheres): see signed_distance.hpp. `axis`
+// is the segments' common direction, or zero for two spheres.
+Eigen::Vector3d fallback_normal(const CoreOutline& a, const CoreOutline& b, double tolerance) {
+  const Eigen::Vector3d axis = a.edge_count() > 0   ? a.edge(0).direction
+                               : b.edge_count() > 0 ? b.edge(0).direction
+                                                    : Eigen::Vector3d::Zero();
+  const auto normal_part = [&](const Eigen::Vector3d& v) -> Eigen::Vector3d {
+    return v - axis * axis.dot(v);
+  };
+  const Eigen::Vector3d between = normal_part(b.posed().r - a.posed().r);
+  if (between.norm() > tolerance) return between.normalized();
+  // Q e_z is normal to its own capsule's axis; one of the two is long enough (1/2 at least when
+  // the other is not, or both are the axis' normal).
+  const Eigen::Vector3d z_a = normal_part(a.face_normal());
+  return (z_a.norm() >= 0.5 ? z_a : normal_part(b.face_normal())).normalized();
+}
+
+NormalSource facet_source(const DeepestFacet& facet, const CoreOutline& a, const CoreOutline& b) {
+  NormalSource source;
+  switch (facet.kind) {
+    case DeepestFacet::Kind::kFace: {
+      const CoreOutline& face = facet.face_core == 0 ? a : b;
+      source.kind = NormalSource::Kind::kFace;
+      source.face_core = facet.face_core;
+      source.sign = facet.normal.dot(face.face_normal()) > 0.0 ? 1.0 : -1.0;
+      break;
+    }
+    case DeepestFacet::Kind::kEdges: {
+      const Eigen::Vector3d e = a.edge(facet.edges[0]).direction;
+      const Eigen::Vector3d f = b.edge(facet.edges[1]).direction;
+      source.kind = NormalSource::Kind::kEdges;
+      source.sign = facet.normal.dot(e.cross(f)) > 0.0 ? 1.0 : -1.0;
+      source.edge_directions = {a.posed().attitude.matrix().transpose() * e,
+                                b.posed().attitude.matrix().transpose() * f};
+      break;
+    }
+    case DeepestFacet::Kind::kNone:
+      source.kind = NormalSource::Kind::kFixed;
+      break;
+  }
+  return source;
+}
+
+CoreOutline outline(const Capsule&, const PosedCore& posed, const PolygonView*) {
+  return CoreOutline(posed);
+}
+CoreOutline outline(const PaddedPolygon&, const PosedCore& posed, const PolygonView* view) {
+  return CoreOutline(*view, posed);
+}
+
+std::optional<PolygonView> polygon_view(const Capsule&, const PairFrame&) { return std::nullopt; }
+std::optional<PolygonView> polygon_view(const PaddedPolygon& polygon, const PairFrame& frame) {
+  return PolygonView(polygon, frame.inverse_scale);
+}
+
+template <class ShapeA, class ShapeB>
+SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, const PosedCore& pb,
+                     const PairFrame& frame) {
+  SignedSolution solution;
+  solution.sides = detail::fast_sides(a, pa, b, pb, frame);
+  const Eigen::Vector3d x1 = pa.r + pa.attitude.matrix() * solution.sides[0].body_point;
+  const Eigen::Vector3d x2 = pb.r + pb.attitude.matrix() * solution.sides[1].body_point;
+  const double apart = (x2 - x1).norm();
+  if (apart > frame.tolerance) {
+    solution.gap = apart;
+    solution.normal = (x2 - x1) / apart;
+    return solution;
+  }
+  const std::optional<PolygonView> view_a = polygon_view(a, frame);
+  const std::optional<PolygonView> view_b = polygon_view(b, frame);
+  const CoreOutline outline_a = outline(a, pa, view_a ? &*view_a : nullptr);
+  const CoreOutline outline_b = outline(b, pb, view_b ? &*view_b : nullptr);
+  const DeepestFacet facet = detail::deepest_facet(outline_a, outline_b, frame.tolerance);
+  solution.penetrating = true;
+  solution.source = facet_source(facet, outline_a, outline_b);
+  if (facet.kind == DeepestFacet::Kind::kNone) {
+    solution.normal = fallback_normal(outline_a, outline_b, frame.tolerance);
+    return solution;  // s = 0: the segments (or points) meet
+  }
+  solution.gap = -facet.depth;
+  solution.normal = facet.normal;
+  if (facet.depth > frame.tolerance) {
+    solution.sides = detail::facet_witnesses(facet, outline_a, outline_b, frame.tolerance);
+  }
+  return solution;
+}
+
+template <class Result, class ShapeA, class ShapeB>
+Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& pose_b) {
+  const PairFrame frame = detail::make_pair_frame(
+      detail::core_size(a), a.radius(), detail::core_size(b), b.radius(), pose_a.r(), pose_b.r());
+  const PosedCore posed_a = detail::posed_core(a, pose_a, pose_a.r(), frame);
+  const PosedCore posed_b = detail::posed_core(b, pose_b, pose_a.r(), frame);
+  const SignedSolution solution = solve(a, posed_a, b, posed_b, frame);
+  if constexpr (std::is_same_v<Result, SignedDistanceJacobian>) {
+    return detail::make_signed_distance_jacobian(frame, pose_a, posed_a, pose_b, posed_b, solution);
+  } else {
+    return detail::make_signed_distance(frame, pose_a, posed_a, pose_b, posed_b, solution);
+  }
+}
+
+}  // namespace
+
+SignedDistance signed_distance(const Capsule& a, const Pose& pose_a, const Capsule& b,
+                               const Pose& pose_b) {
+  return query<SignedDistance>(a, pose_a, b, pose_b);
+}
+SignedDistance signed_distance(const Capsule& a, const Pose& pose_a, const PaddedPolygon& b,
+                               const Pose& pose_b) {
+  return query<SignedDistance>(a, pose_a, b, pose_b);
+}
+SignedDistance signed_distance(const PaddedPolygon& a, const Pose& pose_a, const Capsule& b,
+                               const Pose& pose_b) {
+  return query<SignedDistance>(a, pose_a, b, pose_b);
+}
+SignedDistance signed_distance(const PaddedPolygon& a, const Pose& pose_a, const PaddedPolygon& b,
+                               const Pose& pose_b) {
+  return query<SignedDistance>(a, pose_a, b, pose_b);
+}
+SignedDistance signed_distance(const Shape& a, const Pose& pose_a, const Shape& b,
+                               const Pose& pose_b) {
+  return std::visit(
+      [&](const auto& shape_a, const auto& shape_b) {
+        return query<SignedDistance>(shape_a, pose_a, shape_b, pose_b);
+      },
+      a, b);
+}
+
+SignedDistanceJacobian signed_distance_jacobian(const Capsule& a, const Pose& pose_a,
+                                                const Capsule& b, const Pose& pose_b) {
+  return query<SignedDistanceJacobian>(a, pose_a, b, pose_b);
+}
+SignedDistanceJacobian signed_distance_jacobian(const Capsule& a, const Pose& pose_a,
+                                                const PaddedPolygon& b, const Pose& pose_b) {
+  return query<SignedDistanceJacobian>(a, pose_a, b, pose_b);
+}
+SignedDistanceJacobian signed_distance_jacobian(const PaddedPolygon& a, const Pose& pose_a,
+                                                const Capsule& b, const Pose& pose_b) {
+  return query<SignedDistanceJacobian>(a, pose_a, b, pose_b);
+}
+SignedDistanceJacobian signed_distance_jacobian(const PaddedPolygon& a, const Pose& pose_a,
+                                                const PaddedPolygon& b, const Pose& pose_b) {
+  return query<SignedDistanceJacobian>(a, pose_a, b, pose_b);
+}
+SignedDistanceJacobian signed_distance_jacobian(const Shape& a, const Pose& pose_a, const Shape& b,
+                                                const Pose& pose_b) {
+  return std::visit(
+      [&](const auto& shape_a, const auto& shape_b) {
+        return query<SignedDistanceJacobian>(shape_a, pose_a, shape_b, pose_b);
+      },
+      a, b);
+}
+
+}  // namespace diffpills

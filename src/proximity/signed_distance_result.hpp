@@ -1,0 +1,48 @@
+// From a solved pair to the public signed-distance results (signed_distance.hpp): distance,
+// points, normal, gradient (envelope theorem) and, on request, the Jacobians of the points
+// (implicit function theorem, point_motion.hpp) with the normal's motion. Computed in the query's
+// frame (pair_frame.hpp) and brought back to the inputs' units by powers of its scale: distance,
+// points and the gradient's quaternion part by s, the Jacobians' quaternion columns by s.
+#pragma once
+
+#include <array>
+
+#include "diffpills/signed_distance.hpp"
+#include "pair_frame.hpp"
+#include "posed_core.hpp"
+
+namespace diffpills::detail {
+
+// How the normal moves with the poses: it is the closest points' direction (apart), the normal
+// of a polygon's face or of two edges (a facet of D, penetration.hpp), or a fixed choice (flat D
+// without a facet: parallel segments, spheres).
+struct NormalSource {
+  enum class Kind { kClosestPoints, kFace, kEdges, kFixed };
+  Kind kind = Kind::kClosestPoints;
+  int face_core = 0;  // kFace: normal = sign * Q_face_core e_z
+  double sign = 1.0;  // kFace, kEdges
+  // kEdges: the edges' unit directions in their bodies' frames; normal = sign * unit(a x b) with
+  // a = Q1 edge_directions[0], b = Q2 edge_directions[1].
+  std::array<Eigen::Vector3d, 2> edge_directions = {Eigen::Vector3d::Zero(),
+                                                    Eigen::Vector3d::Zero()};
+};
+
+// The pair's answer in the frame: the two sides, s (|x2 - x1| apart, minus the depth in
+// penetration) and the unit normal with its source.
+struct SignedSolution {
+  std::array<ClosestFeature, 2> sides;
+  double gap = 0.0;
+  bool penetrating = false;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  NormalSource source;
+};
+
+SignedDistance make_signed_distance(const PairFrame& frame, const Pose& pose_a, const PosedCore& a,
+                                    const Pose& pose_b, const PosedCore& b,
+                                    const SignedSolution& solution);
+SignedDistanceJacobian make_signed_distance_jacobian(const PairFrame& frame, const Pose& pose_a,
+                                                     const PosedCore& a, const Pose& pose_b,
+                                                     const PosedCore& b,
+                                                     const SignedSolution& solution);
+
+}  // namespace diffpills::detail
