@@ -159,4 +159,20 @@ Output to_json(const ProximityJacobian& result) {
   return out;
 }
 
+Output to_json(const SignedDistance& result) {
+  return {{"distance", result.distance},
+          {"points", {list(result.points[0]), list(result.points[1])}},
+          {"normal", list(result.normal)},
+          {"gradient", list(result.gradient)},
+          {"core_points", {list(result.core_points[0]), list(result.core_points[1])}},
+          {"penetrating", result.penetrating}};
+}
+
+Output to_json(const SignedDistanceJacobian& result) {
+  Output out = to_json(static_cast<const SignedDistance&>(result));
+  out["jacobian"] = rows(result.points_jacobian);
+  out["core_points_jacobian"] = rows(result.core_points_jacobian);
+  return out;
+}
+
 }  // namespace diffpills::app

@@ -22,5 +22,10 @@ nlohmann::ordered_json to_json(const Shape& shape, const Pose& pose);
 
 nlohmann::ordered_json to_json(const Proximity& result);
 nlohmann::ordered_json to_json(const ProximityJacobian& result);
+// DESIGN.md section 3b: distance, points, normal, gradient (and core_points, penetrating); with
+// the Jacobian, "jacobian" is that of the surface points (6 rows of 14) and "core_points_jacobian"
+// that of the core points.
+nlohmann::ordered_json to_json(const SignedDistance& result);
+nlohmann::ordered_json to_json(const SignedDistanceJacobian& result);
 
 }  // namespace diffpills::app

@@ -25,14 +25,21 @@ A query:
    "b": {"type": "polygon", "C": [[1,0],[0,1],[-1,0],[0,-1]], "d": [1,1,1,1],
          "radius": 0.1, "r": [0,0,1], "q": [1,0,0,0]},
    "jacobian": true}
-  Optional: "jacobian" (false by default), "method": "default" | "interior_point".
+  Optional: "jacobian" (false by default), "method": "default" | "interior_point",
+  "signed_distance" (false by default).
   Quaternions are [w, x, y, z]; a capsule's core lies along its body x axis; a polygon is
   {y : C y <= d} in its body x-y plane with d > 0.
 
 An answer:
   {"phi": ..., "core_points": [p1, p2], "points": [p~1, p~2], "normal": [...],
    "gradient": [14 numbers: dphi/d(r1, q1, r2, q2)], "cores_intersect": false,
-   "jacobian": {"core_points": 6x14 rows, "points": 6x14 rows}}   (jacobian only if asked)
+   "jacobian": {"core_points": 6x14 rows, "points": 6x14 rows},   (jacobian only if asked)
+   "signed_distance": {"distance": ..., "points": [x~1, x~2], "normal": [...],
+     "gradient": [14 numbers: d distance/d(r1, q1, r2, q2)], "core_points": [x1, x2],
+     "penetrating": false, "jacobian": 6x14 rows of the points,
+     "core_points_jacobian": 6x14 rows}}   (signed_distance only if asked, its Jacobians
+                                            only with "jacobian")
+  The signed distance is the gap between the padded shapes, or minus their penetration depth.
   A line that is not a valid query is answered {"error": "<field>: <what is wrong>"}
   and the following lines are still answered.
 

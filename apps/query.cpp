@@ -20,11 +20,19 @@ using json = nlohmann::json;
 // message of megabytes helps nobody.
 constexpr std::size_t kMaxErrorBytes = 1000;
 
+// An optional true/false field, false when absent.
+bool flag(const json& query, const char* key) {
+  if (!query.contains(key)) return false;
+  if (!query[key].is_boolean())
+    throw std::invalid_argument(std::string(key) + ": must be true or false");
+  return query[key].get<bool>();
+}
+
 nlohmann::ordered_json answer(const json& query) {
   if (!query.is_object()) {
     throw std::invalid_argument("query: must be a JSON object with fields \"a\" and \"b\"");
   }
-  static const std::set<std::string> allowed = {"a", "b", "jacobian", "method"};
+  static const std::set<std::string> allowed = {"a", "b", "jacobian", "method", "signed_distance"};
   for (const auto& item : query.items()) {
     if (allowed.count(item.key()) == 0) {
       throw std::invalid_argument(item.key() + ": unknown field");
@@ -35,12 +43,8 @@ nlohmann::ordered_json answer(const json& query) {
   }
   const PosedShape a = parse_posed_shape(query["a"], "a");
   const PosedShape b = parse_posed_shape(query["b"], "b");
-  bool jacobian = false;
-  if (query.contains("jacobian")) {
-    if (!query["jacobian"].is_boolean())
-      throw std::invalid_argument("jacobian: must be true or false");
-    jacobian = query["jacobian"].get<bool>();
-  }
+  const bool jacobian = flag(query, "jacobian");
+  const bool signed_distance = flag(query, "signed_distance");
   ProximityOptions options;
   if (query.contains("method")) {
     const json& method = query["method"];
@@ -52,10 +56,15 @@ nlohmann::ordered_json answer(const json& query) {
       throw std::invalid_argument("method: must be \"default\" or \"interior_point\"");
     }
   }
-  if (jacobian) {
-    return to_json(proximity_jacobian(a.shape, a.pose, b.shape, b.pose, options));
+  nlohmann::ordered_json out =
+      jacobian ? to_json(proximity_jacobian(a.shape, a.pose, b.shape, b.pose, options))
+               : to_json(proximity(a.shape, a.pose, b.shape, b.pose, options));
+  if (signed_distance) {  // (one method: "method" chooses the proximity's solver)
+    out["signed_distance"] =
+        jacobian ? to_json(signed_distance_jacobian(a.shape, a.pose, b.shape, b.pose))
+                 : to_json(diffpills::signed_distance(a.shape, a.pose, b.shape, b.pose));
   }
-  return to_json(proximity(a.shape, a.pose, b.shape, b.pose, options));
+  return out;
 }
 
 // One line of JSON in valid UTF-8: a message may quote bytes of the query that are not UTF-8

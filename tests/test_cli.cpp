@@ -86,6 +86,45 @@ TEST(Cli, AnswerMatchesTheLibrary) {
   EXPECT_NEAR(plain["phi"].get<double>(), expected.phi, 1e-12);
 }
 
+// "signed_distance": true adds the signed distance (DESIGN.md section 3b), as the library gives it.
+TEST(Cli, SignedDistanceMatchesTheLibrary) {
+  // The capsule through the square (penetrating) and far above it (apart).
+  for (const char* height : {"0.1", "3"}) {
+    const std::string upright =
+        std::string(R"({"type": "capsule", "length": 2.0, "radius": 0.2, "r": [0.2, 0, )") +
+        height + R"(], "q": [0.7071067811865476, 0, -0.7071067811865476, 0]})";
+    const json out =
+        answer(query_with(kPolygon, upright, R"(, "signed_distance": true, "jacobian": true)"));
+    Eigen::MatrixX2d C(4, 2);
+    C << 1, 0, 0, 1, -1, 0, 0, -1;
+    const PaddedPolygon polygon(C, Eigen::Vector4d(1, 1, 1, 1), 0.1);
+    const SignedDistanceJacobian expected = signed_distance_jacobian(
+        polygon, Pose({0.3, 0.1, 1}, {0.9, 0.1, 0.2, 0}), Capsule(2.0, 0.2),
+        Pose({0.2, 0, std::stod(height)}, {0.7071067811865476, 0, -0.7071067811865476, 0}));
+    const json& sd = out["signed_distance"];
+    EXPECT_EQ(sd["distance"].get<double>(), expected.distance);
+    EXPECT_EQ(sd["penetrating"].get<bool>(), expected.penetrating);
+    EXPECT_EQ(sd["penetrating"].get<bool>(), std::string(height) == "0.1");
+    for (int i = 0; i < 2; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(sd["points"][i][k].get<double>(), expected.points[i](k));
+        EXPECT_EQ(sd["core_points"][i][k].get<double>(), expected.core_points[i](k));
+      }
+    }
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(sd["normal"][k].get<double>(), expected.normal(k));
+    for (int k = 0; k < 14; ++k) EXPECT_EQ(sd["gradient"][k].get<double>(), expected.gradient(k));
+    ASSERT_EQ(sd["jacobian"].size(), 6u);
+    EXPECT_EQ(sd["jacobian"][5][13].get<double>(), expected.points_jacobian(5, 13));
+    EXPECT_EQ(sd["core_points_jacobian"][0][4].get<double>(), expected.core_points_jacobian(0, 4));
+    EXPECT_TRUE(out.contains("phi"));  // the proximity's answer is still there
+  }
+  const json plain = answer(query_with(kCapsule, kPolygon, R"(, "signed_distance": true)"));
+  EXPECT_FALSE(plain["signed_distance"].contains("jacobian"));
+  EXPECT_FALSE(answer(query_with(kCapsule, kPolygon, R"(, "signed_distance": false)"))
+                   .contains("signed_distance"));
+  expect_error(query_with(kCapsule, kPolygon, R"(, "signed_distance": 1)"), "signed_distance");
+}
+
 TEST(Cli, BadInputGetsAnErrorNamingTheField) {
   expect_error("{\"a\": ", "a: malformed JSON");  // the value of "a" is missing
   expect_error("[1, 2]", "query");
