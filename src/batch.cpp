@@ -9,7 +9,10 @@
 #include <string>
 #include <system_error>
 #include <thread>
+#include <utility>
 #include <vector>
+
+#include "diffpills/signed_distance.hpp"
 
 namespace diffpills {
 namespace {
@@ -33,29 +36,43 @@ Pose pose_at(const Eigen::Ref<const PositionArray>& r, const Eigen::Ref<const Qu
   }
 }
 
-}  // namespace
+// A solver failure of row i says which row: "row 17: the interior-point method stopped ...".
+// (An invalid pose already names its row, pose_at.)
+std::exception_ptr with_row(std::exception_ptr error, Eigen::Index row) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const SolverError& failure) {
+    return std::make_exception_ptr(
+        SolverError("row " + std::to_string(row) + ": " + std::string(failure.what())));
+  } catch (...) {
+    return error;
+  }
+}
 
-void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
-                     const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
-                     const Eigen::Ref<const PositionArray>& r_b,
-                     const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> phi,
-                     Eigen::Ref<GradientArray> gradient, const BatchOptions& options) {
+// The batch of either query: row i gets `query(pose_a[i], pose_b[i])`'s value and gradient.
+// `name` and `value_name` are the function's and its output's names, for messages.
+template <class Query>
+void run_batch(const char* name, const char* value_name, const Eigen::Ref<const PositionArray>& r_a,
+               const Eigen::Ref<const QuaternionArray>& q_a,
+               const Eigen::Ref<const PositionArray>& r_b,
+               const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> value,
+               Eigen::Ref<GradientArray> gradient, const BatchOptions& options,
+               const Query& query) {
   const Eigen::Index n = r_a.rows();
   if (q_a.rows() != n || r_b.rows() != n || q_b.rows() != n) {
     throw std::invalid_argument(
-        "proximity_batch: r_a, q_a, r_b and q_b must have the same number "
-        "of rows (got " +
+        std::string(name) + ": r_a, q_a, r_b and q_b must have the same number of rows (got " +
         std::to_string(n) + ", " + std::to_string(q_a.rows()) + ", " + std::to_string(r_b.rows()) +
         ", " + std::to_string(q_b.rows()) + ")");
   }
   if (options.threads < 0) {
     throw std::invalid_argument("threads: must be >= 0 (0 = every hardware thread)");
   }
-  if (phi.size() != n || gradient.rows() != n) {
-    throw std::invalid_argument("proximity_batch: phi and gradient must have one row per pose (" +
-                                std::to_string(n) + ")");
+  if (value.size() != n || gradient.rows() != n) {
+    throw std::invalid_argument(std::string(name) + ": " + value_name +
+                                " and gradient must have one row per pose (" + std::to_string(n) +
+                                ")");
   }
-  const ProximityOptions single{options.method};
 
   // Threads take blocks of kBlock rows from a shared counter: pair costs vary (a crossing pair
   // of polygons stops early, a distant one prunes most edge pairs), and a fixed split into one
@@ -81,17 +98,16 @@ void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
       if (begin > first_error_row) return;  // a lower row already failed; the rest is moot
       for (Eigen::Index i = begin; i < end; ++i) {
         try {
-          const Proximity single_result =
-              proximity(a, pose_at(r_a, q_a, i, "a"), b, pose_at(r_b, q_b, i, "b"), single);
-          phi(i) = single_result.phi;
-          gradient.row(i) = single_result.gradient.transpose();
+          const auto single = query(pose_at(r_a, q_a, i, "a"), pose_at(r_b, q_b, i, "b"));
+          value(i) = single.first;
+          gradient.row(i) = single.second.transpose();
         } catch (...) {
           // Every block below a failing row is still processed, so the lowest row recorded is
           // the first bad row whatever the thread timing.
           const std::lock_guard<std::mutex> lock(error_mutex);
           if (i < first_error_row) {
             first_error_row = i;
-            first_error = std::current_exception();
+            first_error = with_row(std::current_exception(), i);
           }
           break;
         }
@@ -118,6 +134,34 @@ void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
   if (first_error) std::rethrow_exception(first_error);
 }
 
+}  // namespace
+
+void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
+                     const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
+                     const Eigen::Ref<const PositionArray>& r_b,
+                     const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> phi,
+                     Eigen::Ref<GradientArray> gradient, const BatchOptions& options) {
+  const ProximityOptions single{options.method};
+  run_batch("proximity_batch", "phi", r_a, q_a, r_b, q_b, phi, gradient, options,
+            [&](const Pose& pose_a, const Pose& pose_b) {
+              const Proximity result = proximity(a, pose_a, b, pose_b, single);
+              return std::make_pair(result.phi, result.gradient);
+            });
+}
+
+void signed_distance_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
+                           const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
+                           const Eigen::Ref<const PositionArray>& r_b,
+                           const Eigen::Ref<const QuaternionArray>& q_b,
+                           Eigen::Ref<Eigen::VectorXd> distance, Eigen::Ref<GradientArray> gradient,
+                           const BatchOptions& options) {
+  run_batch("signed_distance_batch", "distance", r_a, q_a, r_b, q_b, distance, gradient, options,
+            [&](const Pose& pose_a, const Pose& pose_b) {
+              const SignedDistance result = signed_distance(a, pose_a, b, pose_b);
+              return std::make_pair(result.distance, result.gradient);
+            });
+}
+
 BatchResult proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
                             const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
                             const Eigen::Ref<const PositionArray>& r_b,
@@ -127,6 +171,20 @@ BatchResult proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray
   result.phi.resize(r_a.rows());
   result.gradient.resize(r_a.rows(), 14);
   proximity_batch(a, r_a, q_a, b, r_b, q_b, result.phi, result.gradient, options);
+  return result;
+}
+
+SignedDistanceBatchResult signed_distance_batch(const Shape& a,
+                                                const Eigen::Ref<const PositionArray>& r_a,
+                                                const Eigen::Ref<const QuaternionArray>& q_a,
+                                                const Shape& b,
+                                                const Eigen::Ref<const PositionArray>& r_b,
+                                                const Eigen::Ref<const QuaternionArray>& q_b,
+                                                const BatchOptions& options) {
+  SignedDistanceBatchResult result;
+  result.distance.resize(r_a.rows());
+  result.gradient.resize(r_a.rows(), 14);
+  signed_distance_batch(a, r_a, q_a, b, r_b, q_b, result.distance, result.gradient, options);
   return result;
 }
 

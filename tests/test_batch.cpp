@@ -93,6 +93,54 @@ TEST(Batch, ReportsTheFirstBadRow) {
   }
 }
 
+TEST(Batch, SignedDistanceEntriesEqualTheSingleCall) {
+  Rng rng(63);
+  const Shape capsule = random_capsule(rng, 1.0).shape;
+  const Shape polygon = random_polygon(rng, 1.0).shape;
+  const Arrays arrays = random_arrays(rng, 1001);
+  for (const auto& [a, b] : {std::pair{capsule, capsule}, std::pair{capsule, polygon},
+                             std::pair{polygon, capsule}, std::pair{polygon, polygon}}) {
+    for (int threads : {1, 2, 0}) {
+      const SignedDistanceBatchResult batch =
+          signed_distance_batch(a, arrays.r_a, arrays.q_a, b, arrays.r_b, arrays.q_b, {threads});
+      ASSERT_EQ(batch.distance.size(), 1001);
+      for (Eigen::Index i = 0; i < 1001; ++i) {
+        const SignedDistance single =
+            signed_distance(a, Pose(arrays.r_a.row(i).transpose(), arrays.q_a.row(i).transpose()),
+                            b, Pose(arrays.r_b.row(i).transpose(), arrays.q_b.row(i).transpose()));
+        ASSERT_EQ(batch.distance(i), single.distance) << "row " << i << ", threads " << threads;
+        ASSERT_EQ(batch.gradient.row(i), single.gradient.transpose());
+      }
+    }
+  }
+  Arrays bad = arrays;
+  bad.q_a.row(77).setZero();
+  try {
+    signed_distance_batch(capsule, bad.r_a, bad.q_a, polygon, bad.r_b, bad.q_b);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("q_a[77]: quaternion must be nonzero", 0), 0u)
+        << error.what();
+  }
+}
+
+// A solver failure names its row: the interior-point method's iteration cap, met on a pair 1e11
+// apart whose capsule is 1e-11 of that (a QP too badly scaled for it; the default path answers).
+TEST(Batch, ASolverFailureNamesItsRow) {
+  PositionArray r_a = PositionArray::Zero(3, 3), r_b(3, 3);
+  QuaternionArray q_a(3, 4), q_b(3, 4);
+  q_a.rowwise() = Eigen::RowVector4d(1, 0, 0, 0);
+  q_b.rowwise() = Eigen::RowVector4d(0.9, 0.1, 0.3, 0.2);
+  r_b << 1, 2, 3, 3e10, 1e11, 2e10, 4, 5, 6;
+  try {
+    proximity_batch(Capsule(0, 0), r_a, q_a, Capsule(1, 0), r_b, q_b, {1, Method::kInteriorPoint});
+    ADD_FAILURE() << "no exception";
+  } catch (const SolverError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("row 1: ", 0), 0u) << error.what();
+  }
+  EXPECT_NO_THROW(proximity_batch(Capsule(0, 0), r_a, q_a, Capsule(1, 0), r_b, q_b));
+}
+
 TEST(Batch, AMillionThreadsAreCappedAndGiveTheSingleCalls) {
   // 10^6 rows asked of 10^6 threads once started one thread per 512-row block (1954), and the
   // process ended when the system refused one.

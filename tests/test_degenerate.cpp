@@ -145,6 +145,22 @@ TEST(Degenerate, CrossingCores) {
   EXPECT_NEAR(cross.phi, -0.01, 1e-14);
 }
 
+// Cores within the tolerance (1e-12 of the scene) of each other intersect, and say so
+// consistently: phi = -(R1 + R2)^2, not the tiny positive |p1 - p2|^2 (found by a hostile review:
+// phi = 1e-18 with cores_intersect for a 1e6 capsule crossing another 1e-9 below it).
+TEST(Degenerate, IntersectingWithinTheToleranceIsFlat) {
+  const Capsule long_capsule(1e6, 0.0), short_capsule(1.0, 0.0);
+  const Proximity p = proximity(long_capsule, Pose(), short_capsule,
+                                Pose({0, 0, 1e-9}, {0.7071067811865476, 0, 0, 0.7071067811865476}));
+  EXPECT_TRUE(p.cores_intersect);
+  EXPECT_EQ(p.phi, 0.0);
+  EXPECT_TRUE(p.gradient.isZero(0.0));
+  const Proximity padded =
+      proximity(Capsule(1e6, 0.5), Pose(), Capsule(1.0, 0.25),
+                Pose({0, 0, 1e-9}, {0.7071067811865476, 0, 0, 0.7071067811865476}));
+  EXPECT_EQ(padded.phi, -0.75 * 0.75);
+}
+
 TEST(Degenerate, IdenticalShapesAtTheSamePose) {
   const Pose pose({1, 2, 3}, about(0.7, 0.6, 0.8, 0));
   const Eigen::Vector3d body_z = rotation_matrix(pose.q()).col(2);

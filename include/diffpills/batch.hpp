@@ -1,5 +1,6 @@
 // Many queries of one shape pair at once: the poses come as arrays, the work is split across
-// threads, and every entry equals the single call proximity(a, pose_a[i], b, pose_b[i]).
+// threads, and every entry equals the single call proximity(a, pose_a[i], b, pose_b[i]) (or
+// signed_distance(...) for signed_distance_batch).
 #pragma once
 
 #include <Eigen/Core>
@@ -49,5 +50,27 @@ void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
                      const Eigen::Ref<const PositionArray>& r_b,
                      const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> phi,
                      Eigen::Ref<GradientArray> gradient, const BatchOptions& options = {});
+
+struct SignedDistanceBatchResult {
+  Eigen::VectorXd distance;  // N
+  GradientArray gradient;    // N x 14, the layout of SignedDistance::gradient
+};
+
+// The signed distance (signed_distance.hpp) and its gradient for every pose pair, with the
+// threads, errors and outputs of proximity_batch (options.method is not used: the signed distance
+// has one method).
+SignedDistanceBatchResult signed_distance_batch(const Shape& a,
+                                                const Eigen::Ref<const PositionArray>& r_a,
+                                                const Eigen::Ref<const QuaternionArray>& q_a,
+                                                const Shape& b,
+                                                const Eigen::Ref<const PositionArray>& r_b,
+                                                const Eigen::Ref<const QuaternionArray>& q_b,
+                                                const BatchOptions& options = {});
+void signed_distance_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
+                           const Eigen::Ref<const QuaternionArray>& q_a, const Shape& b,
+                           const Eigen::Ref<const PositionArray>& r_b,
+                           const Eigen::Ref<const QuaternionArray>& q_b,
+                           Eigen::Ref<Eigen::VectorXd> distance, Eigen::Ref<GradientArray> gradient,
+                           const BatchOptions& options = {});
 
 }  // namespace diffpills

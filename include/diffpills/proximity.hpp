@@ -44,9 +44,11 @@
 //     gradient's position part by 2^k and its quaternion part by 2^(2k), bit for bit. The normal
 //     is unit to rounding at every scale.
 //
-// Errors: shapes and poses validate on construction (std::invalid_argument). If the QP solver
-// fails to converge, which the tests have never seen for valid shapes, the query throws
-// SolverError rather than return an unverified answer.
+// Errors: shapes and poses validate on construction (std::invalid_argument). The default method
+// never fails on valid shapes. The interior-point reference can: on badly scaled pairs (a core
+// 1e-11 or less the size of the pair's separation, say, where its QP's data span 22 orders of
+// magnitude) it may reach its iteration cap, and then throws SolverError rather than return an
+// unverified answer.
 #pragma once
 
 #include <Eigen/Core>

@@ -21,6 +21,18 @@ from . import _core
 __all__ = ["proximity"]
 
 
+def _refuse_second_derivatives():
+    # A backward pass that builds a graph (create_graph=True, as for Hessians or gradient
+    # penalties) would treat the saved gradient as a constant and silently drop every second
+    # derivative through it; torch's once_differentiable does not catch that when the incoming
+    # gradient itself needs no grad. Say so instead.
+    if torch.is_grad_enabled():
+        raise RuntimeError(
+            "diffpills.torch is once differentiable: second derivatives (backward with "
+            "create_graph=True) are not available"
+        )
+
+
 def _as_numpy(tensor):
     return np.ascontiguousarray(tensor.detach().to(device="cpu", dtype=torch.float64).numpy())
 
@@ -44,8 +56,8 @@ class _Proximity(torch.autograd.Function):
         return torch.from_numpy(phi).to(device=r_a.device, dtype=r_a.dtype)
 
     @staticmethod
-    @torch.autograd.function.once_differentiable
     def backward(ctx, grad_phi):
+        _refuse_second_derivatives()
         (gradient,) = ctx.saved_tensors
         weighted = gradient * grad_phi.unsqueeze(1)
         return (

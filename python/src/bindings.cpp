@@ -217,7 +217,10 @@ int thread_count(const py::handle& value) {
     throw py::type_error("threads: expected an int, got " + type_name(value));
   }
   const auto number = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
-  if (!number) throw py::error_already_set();
+  if (!number) {  // e.g. a NumPy array of one element, whose __index__ refuses
+    PyErr_Clear();
+    throw py::type_error("threads: expected an int, got " + type_name(value));
+  }
   int overflow = 0;
   const long long count = PyLong_AsLongLongAndOverflow(number.ptr(), &overflow);
   if (overflow != 0 || count < 0 || count > INT_MAX) {

@@ -78,7 +78,7 @@ def _pybind11_dump(error):
 @pytest.mark.parametrize(
     "threads, error",
     [(-1, ValueError), (2**40, ValueError), (-(2**70), ValueError), (None, TypeError), (2.0, TypeError),
-     ("2", TypeError), (True, TypeError)],
+     ("2", TypeError), (True, TypeError), (np.array([2]), TypeError)],
 )
 def test_bad_thread_counts_name_threads(threads, error):
     capsule = diffpills.Capsule(1.0, 0.1)

@@ -41,6 +41,21 @@ def test_gradcheck_float64(first, second):
     )
 
 
+def test_second_derivatives_are_refused_not_silently_wrong():
+    # create_graph=True would treat the saved gradient as a constant: d/dr (dphi/dr)^2 would come
+    # out as 0 instead of 2 (dphi/dr) (d2phi/dr2). A clear error instead.
+    capsule = diffpills.Capsule(1.0, 0.1)
+    r = torch.tensor([[0.0, 0.0, 1.0]], dtype=torch.float64, requires_grad=True)
+    q = torch.tensor([1.0, 0.0, 0.0, 0.0], dtype=torch.float64)
+    phi = dtorch.proximity(capsule, r, q, capsule, torch.zeros(3, dtype=torch.float64), q)
+    with pytest.raises(RuntimeError, match="once differentiable"):
+        torch.autograd.grad(phi.sum(), r, create_graph=True)
+    # The first derivative alone still works.
+    phi = dtorch.proximity(capsule, r, q, capsule, torch.zeros(3, dtype=torch.float64), q)
+    (g,) = torch.autograd.grad(phi.sum(), r)
+    assert torch.allclose(g, torch.tensor([[0.0, 0.0, 2.0]], dtype=torch.float64))
+
+
 def test_matches_the_batch_and_float32_is_within_its_precision():
     rng = np.random.default_rng(12)
     a, _ = random_polygon(rng)

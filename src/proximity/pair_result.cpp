@@ -48,18 +48,25 @@ Proximity make_proximity(const PairFrame& frame, const Pose& pose_a, const Posed
   result.gradient.segment<3>(7) = -2.0 * difference;
   result.gradient.segment<4>(10) = -2.0 * b.attitude.rotate_gradient(side_b.body_point, difference);
 
-  switch (normal_rule(frame, a, b, p1, p2)) {
+  const NormalRule rule = normal_rule(frame, a, b, p1, p2);
+  switch (rule) {
     case NormalRule::kClosestPoints:
       result.normal = difference * (-1.0 / difference.norm());  // one division, not three
       break;
     case NormalRule::kOrigins:
-      result.cores_intersect = true;
       result.normal = (b.r - a.r).normalized();
       break;
     case NormalRule::kBodyAxis:
-      result.cores_intersect = true;
       result.normal = a.attitude.matrix().col(2);
       break;
+  }
+  if (rule != NormalRule::kClosestPoints) {
+    // Cores within the tolerance of each other intersect, as documented: phi is -(R1 + R2)^2 and
+    // flat. (|p1 - p2|^2, at most the tolerance squared, 1e-24 of the scene's size squared, is
+    // dropped: a phi above -(R1 + R2)^2, even positive for bare cores, would say "apart".)
+    result.cores_intersect = true;
+    result.phi = -radius_sum * radius_sum;
+    result.gradient.setZero();
   }
   restore_units(frame, result);
   result.core_points = {pose_a.r() + frame.scale * offset_a, pose_b.r() + frame.scale * offset_b};
