@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstring>
 #include <istream>
+#include <new>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <set>
@@ -120,6 +121,9 @@ std::string answer_query_line(const std::string& line, bool& ok) {
     std::string result = to_line(answer(parse_json_line(line)));
     ok = true;
     return result;
+  } catch (const std::bad_alloc&) {
+    return error_answer("query: not enough memory to parse this line (" +
+                        std::to_string(line.size()) + " bytes)");
   } catch (const std::exception& error) {
     return error_answer(error.what());
   }

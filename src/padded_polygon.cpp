@@ -42,6 +42,9 @@ struct UnitRow {
   double angle = 0.0;
 };
 
+// The smallest normalized offset d_i / |C_i| accepted.
+constexpr double kMinOffset = 1e-300;
+
 double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
 }
@@ -93,7 +96,17 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
                        detail::format_number(d(i)) + ")");
     }
     UnitRow unit;
-    if (normalize_row(C(i, 0), C(i, 1), d(i), unit)) rows.push_back(unit);
+    if (!normalize_row(C(i, 0), C(i, 1), d(i), unit)) continue;
+    // Below this the offset is subnormal or zero: the origin would sit on the row's line, and the
+    // vertices would lose their digits (a hostile review found 2 C, d = 5e-324 accepted with
+    // every vertex at 0).
+    if (!(unit.offset >= kMinOffset)) {
+      detail::fail("polygon.d" + row(),
+                   "must be at least 1e-300 times |C" + row() +
+                       "| (got d = " + detail::format_number(d(i)) + ", |C" + row() +
+                       "| = " + detail::format_number(std::hypot(C(i, 0), C(i, 1))) + ")");
+    }
+    rows.push_back(unit);
   }
   const auto unbounded = [] {
     detail::fail("polygon.C", "the rows C y <= d do not bound a polygon (it is unbounded)");
@@ -145,7 +158,7 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
                                     c.offset * Eigen::Vector2d(-a.normal.y(), a.normal.x())) /
                                    turn;
     vertices_.row(i) = vertex.transpose();
-    extent_ = std::max(extent_, vertex.norm());
+    extent_ = std::max(extent_, std::hypot(vertex.x(), vertex.y()));  // no underflow of squares
   }
   if (!(extent_ <= 1e12 * largest_offset)) unbounded();
   if (!(extent_ <= kMaxMagnitude)) {

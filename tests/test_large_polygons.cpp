@@ -216,7 +216,7 @@ TEST(LargePolygons, PolygonsFarSmallerThanTheirDistance) {
 
   // Two polygons whose vertices all underflow to their origins in the frame, one origin in the
   // other's plane: a window of three coincident vertices would be an unbounded wedge.
-  const PaddedPolygon a = regular(461, 5.2e-311, 0.25), b = regular(293, 2.2e-308, 0.0);
+  const PaddedPolygon a = regular(461, 1e-300, 0.25), b = regular(293, 2e-300, 0.0);
   const Pose pa(Eigen::Vector3d(-4.2e78, 3.1e-115, 9e-188), about(M_PI / 2, 1, 0, 0));
   const Pose pb(Eigen::Vector3d(1.5, 3.05e-115, 3), about(M_PI, 1, 0, 0));
   for (const Method method : {Method::kDefault, Method::kInteriorPoint}) {

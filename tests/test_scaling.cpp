@@ -230,7 +230,7 @@ TEST(Scaling, PolygonsWithTinyOffsets) {
 TEST(Scaling, PolygonBelowTheFramesResolution) {
   Eigen::MatrixX2d C(4, 2);
   C << 1, 0, 0, 1, -1, 0, 0, -1;
-  const PaddedPolygon speck(C, Eigen::Vector4d::Constant(3e-317), 0.0);
+  const PaddedPolygon speck(C, Eigen::Vector4d::Constant(1e-300), 0.0);
   const Capsule capsule(2e-283, 6e10);
   const Pose far(Eigen::Vector3d(3.8e53, 0, 0), kIdentity);
   for (const Method method : {Method::kDefault, Method::kInteriorPoint}) {

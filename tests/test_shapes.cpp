@@ -120,6 +120,19 @@ TEST(Shapes, PoseRejectsBadNumbers) {
   EXPECT_NO_THROW(Pose({0, 0, 0}, {1e-40, 0, 0, 0}));
 }
 
+// Offsets whose normalized value d_i / |C_i| underflows are refused, naming the row (a hostile
+// review found them accepted with every vertex at 0); 1e-300 itself is accepted.
+TEST(Shapes, PolygonRejectsOffsetsThatUnderflow) {
+  Eigen::MatrixX2d C(4, 2);
+  C << 1, 0, 0, 1, -1, 0, 0, -1;
+  expect_invalid([&] { PaddedPolygon(2 * C, Eigen::Vector4d::Constant(5e-324), 0.0); },
+                 "polygon.d[0]: must be at least 1e-300");
+  expect_invalid([&] { PaddedPolygon(1e100 * C, Eigen::Vector4d::Constant(1e-300), 0.0); },
+                 "polygon.d[0]");
+  const PaddedPolygon tiny(C, Eigen::Vector4d::Constant(1e-300), 0.0);
+  EXPECT_GT(tiny.extent(), 0.0);
+}
+
 TEST(Shapes, PolygonRejectsBadRows) {
   expect_invalid([] { PaddedPolygon(Eigen::MatrixX2d(2, 2), Eigen::Vector2d(1, 1), 0.1); },
                  "polygon.C");  // fewer than 3 rows

@@ -38,11 +38,16 @@
 //     1's body z axis Q(q1) [0, 0, 1]. Surface points and Jacobians follow that rule.
 //   - Non-unit quaternions are normalized; derivatives include the normalization.
 //   - Magnitudes. Every accepted input (lengths, radii, positions and offsets from 0 up to
-//     kMaxMagnitude, polygons with offsets d as small as 1e-300) is answered to full relative
-//     accuracy: each pair is solved in a frame whose unit is a power of two near the scene's size,
-//     so scaling every length by 2^k scales phi by exactly 2^(2k), the points by 2^k, the
-//     gradient's position part by 2^k and its quaternion part by 2^(2k), bit for bit. The normal
-//     is unit to rounding at every scale.
+//     kMaxMagnitude, polygons with offsets d_i / |C_i| as small as 1e-300) is answered to full
+//     accuracy relative to the pair's scene: each pair is solved in a frame whose unit is a power
+//     of two near the scene's size (the largest of the cores' sizes, the radii and the distance
+//     between the body origins), and lengths come out with errors of about 1e-16 of that size. A
+//     gap far smaller than the scene is resolved only to that absolute error: a point 1 from the
+//     middle of a 1e20-long capsule gets phi to about (1e-16 * 1e20)^2, and two specks 1e-300
+//     apart beside a unit capsule get phi = 0. Scaling every length by 2^k scales phi by exactly
+//     2^(2k), the points by 2^k, the gradient's position part by 2^k and its quaternion part by
+//     2^(2k), bit for bit, while no length of the scene leaves the normal doubles (below ~1e-290
+//     squares underflow). The normal is unit to rounding at every scale.
 //
 // Errors: shapes and poses validate on construction (std::invalid_argument). The default method
 // never fails on valid shapes. The interior-point reference can: on badly scaled pairs (a core

@@ -35,7 +35,8 @@ class Capsule {
 // A padded polygon: the core is {y in R^2 : C y <= d} in the body x-y plane, padded by the radius
 // R. Requirements (each violation throws std::invalid_argument naming the field):
 //   - C is m x 2 and d has m entries, m >= 3, every entry finite;
-//   - d > 0: the body origin lies strictly inside the polygon;
+//   - d > 0: the body origin lies strictly inside the polygon; and d_i / |C_i| >= 1e-300 for
+//     every nonzero row (an offset that underflows would put the origin on the boundary);
 //   - the polygon is bounded;
 //   - 0 <= radius <= kMaxMagnitude.
 // Redundant rows (zero rows, rows implied by others, duplicates, rows that cut less than 1e-12 of
