@@ -281,6 +281,28 @@ TEST(Scaling, CoplanarSpeckBesideAHugePolygon) {
             centre_distance - 1e70 / std::cos(M_PI / 51) * (1 + 1e-12));
 }
 
+// A radius 1e-158 of the scene: in the pair's frame (R1 + R2)^2 is subnormal and loses digits, so
+// the radius term is taken in the inputs' units and phi >= -(R1 + R2)^2 holds (found by
+// fuzz_proximity: phi = -4.07e-133 for (R1 + R2)^2 = 4.067e-133).
+TEST(Scaling, RadiusFarBelowTheScene) {
+  Eigen::MatrixX2d triangle(3, 2), C(35, 2);
+  triangle << 1, 0, -0.5, std::sqrt(0.75), -0.5, -std::sqrt(0.75);
+  for (int k = 0; k < 35; ++k) C.row(k) << std::cos(2 * M_PI * k / 35), std::sin(2 * M_PI * k / 35);
+  const PaddedPolygon speck(triangle, Eigen::Vector3d::Constant(1.3241822640263115e-300), 0.0);
+  const double radius = 6.376925397871113e-67;
+  const PaddedPolygon huge(C, Eigen::VectorXd::Constant(35, 9.3182071319932369e+90), radius);
+  const Pose pose_speck({1.2099298215479115e+62, 0.375, 0.375}, {1e100, 0.375, 0.375, 0.375});
+  const Pose pose_huge({0.375, 0.375, 0.375}, {0.375, 0.375, 0.375, 0.375});
+  for (const bool swap : {false, true}) {
+    const Proximity p = swap ? proximity(huge, pose_huge, speck, pose_speck)
+                             : proximity(speck, pose_speck, huge, pose_huge);
+    EXPECT_GE(p.phi, -radius * radius);
+    const SignedDistance sd = swap ? signed_distance(huge, pose_huge, speck, pose_speck)
+                                   : signed_distance(speck, pose_speck, huge, pose_huge);
+    EXPECT_TRUE(std::isfinite(sd.distance) && sd.gradient.allFinite());
+  }
+}
+
 // The smallest accepted quaternion norm in the largest accepted scene: derivatives with respect to
 // q carry 1 / |q|, and stay finite (fuzz_proximity found an infinite gradient with |q| = 2e-146
 // and lengths near 1e100, then accepted).

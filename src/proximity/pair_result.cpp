@@ -40,8 +40,12 @@ Proximity make_proximity(const PairFrame& frame, const Pose& pose_a, const Posed
   const Eigen::Vector3d p1 = a.r + offset_a;
   const Eigen::Vector3d p2 = b.r + offset_b;
   const Eigen::Vector3d difference = p1 - p2;
-  const double radius_sum = a.radius + b.radius;
-  result.phi = difference.squaredNorm() - radius_sum * radius_sum;  // eq. caps_prox
+  // phi = |p1 - p2|^2 - (R1 + R2)^2 (eq. caps_prox): the squared distance in the frame, brought
+  // to the inputs' units (restore_units), less the radius term in the inputs' units. In the frame
+  // (R1 + R2)^2 may underflow to a subnormal, and lose digits, where phi's own scale does not
+  // (fuzz_proximity: a radius 1e-158 of the scene gave phi below -(R1 + R2)^2).
+  const double radius_sum = a.input_radius + b.input_radius;
+  result.phi = difference.squaredNorm();
   // Envelope theorem: d phi = 2 (p1 - p2)' (dp1 - dp2) with the body points held fixed.
   result.gradient.segment<3>(0) = 2.0 * difference;
   result.gradient.segment<4>(3) = 2.0 * a.attitude.rotate_gradient(side_a.body_point, difference);
@@ -65,14 +69,15 @@ Proximity make_proximity(const PairFrame& frame, const Pose& pose_a, const Posed
     // flat. (|p1 - p2|^2, at most the tolerance squared, 1e-24 of the scene's size squared, is
     // dropped: a phi above -(R1 + R2)^2, even positive for bare cores, would say "apart".)
     result.cores_intersect = true;
-    result.phi = -radius_sum * radius_sum;
+    result.phi = 0.0;
     result.gradient.setZero();
   }
   restore_units(frame, result);
+  result.phi -= radius_sum * radius_sum;
   result.core_points = {pose_a.r() + frame.scale * offset_a, pose_b.r() + frame.scale * offset_b};
-  const double radius_a = frame.scale * a.radius, radius_b = frame.scale * b.radius;
-  result.points = {result.core_points[0] + radius_a * result.normal,
-                   result.core_points[1] - radius_b * result.normal};  // eqs. caps_c_1, caps_c_2
+  result.points = {
+      result.core_points[0] + a.input_radius * result.normal,
+      result.core_points[1] - b.input_radius * result.normal};  // eqs. caps_c_1, caps_c_2
   return result;
 }
 

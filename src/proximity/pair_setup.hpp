@@ -24,7 +24,8 @@ template <class Shape>
 PosedCore posed_core(const Shape& shape, const Pose& pose, const Eigen::Vector3d& origin,
                      const PairFrame& frame) {
   return {(pose.r() - origin) * frame.inverse_scale, detail::UnitQuaternion(pose.q()),
-          shape.radius() * frame.inverse_scale, core_size(shape) * frame.inverse_scale};
+          shape.radius() * frame.inverse_scale, core_size(shape) * frame.inverse_scale,
+          shape.radius()};
 }
 
 inline Sides fast_sides(const Capsule&, const PosedCore& pa, const Capsule&, const PosedCore& pb,

@@ -21,6 +21,9 @@ struct PosedCore {
   UnitQuaternion attitude;  // q normalized once, and Q(q); derivatives refer to q as given
   double radius = 0.0;
   double size = 0.0;  // a capsule's length, a polygon's extent (also the relative-tolerance scale)
+  // The radius in the inputs' units, for the results' radius terms: radius above may be subnormal
+  // or zero in the frame (a radius 1e-160 of the scene), this is exact.
+  double input_radius = 0.0;
 };
 
 // One core's side of a solved pair, in fixed-size form: what every solver (closed form, feature

@@ -28,7 +28,9 @@ SignedDistance make_signed_distance(const PairFrame& frame, const Pose& pose_a, 
   const Eigen::Vector3d& n = solution.normal;
   const Eigen::Vector3d& u1 = solution.sides[0].body_point;
   const Eigen::Vector3d& u2 = solution.sides[1].body_point;
-  result.distance = (solution.gap - a.radius - b.radius) * s;
+  // The radius term in the inputs' units (posed_core.hpp): exact, also for radii that are
+  // subnormal in the frame; gap * s is exact too, so scaling by 2^k stays exact.
+  result.distance = solution.gap * s - (a.input_radius + b.input_radius);
   result.penetrating = solution.penetrating;
   result.normal = n;
   // Envelope theorem (see the header): d distance = n . (dx2 - dx1), body points fixed.
@@ -38,8 +40,8 @@ SignedDistance make_signed_distance(const PairFrame& frame, const Pose& pose_a, 
   result.gradient.segment<4>(10) = b.attitude.rotate_gradient(u2, n) * s;
   result.core_points = {pose_a.r() + s * (a.attitude.matrix() * u1),
                         pose_b.r() + s * (b.attitude.matrix() * u2)};
-  result.points = {result.core_points[0] + (s * a.radius) * n,
-                   result.core_points[1] - (s * b.radius) * n};
+  result.points = {result.core_points[0] + a.input_radius * n,
+                   result.core_points[1] - b.input_radius * n};
   return result;
 }
 
