@@ -13,7 +13,10 @@
 //   - finite phi, points, gradient and Jacobians; a unit normal; phi >= -(R1 + R2)^2;
 //   - swap symmetry: proximity(b, a) has the same phi and the points swapped;
 //   - the interior-point reference agrees with the default path on phi (one pair in four);
-//   - proximity_batch over a few rows and threads equals the single calls bit for bit.
+//   - proximity_batch over a few rows and threads equals the single calls bit for bit;
+//   - the signed distance: finite, a unit normal, swap symmetry, points[1] - points[0] =
+//     distance * normal, and agreement with proximity()'s closest points where the cores are
+//     apart (distance + R1 + R2 = |p1 - p2|) or at most -(R1 + R2) where they intersect.
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <Eigen/Core>
@@ -211,6 +214,43 @@ void compare_with_interior_point(const Shape& a, const Pose& pose_a, const Shape
   }
 }
 
+void check_signed_distance(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                           const diffpills::ProximityJacobian& proximity, double radii,
+                           double scene) {
+  const diffpills::SignedDistanceJacobian ab =
+      diffpills::signed_distance_jacobian(a, pose_a, b, pose_b);
+  const diffpills::SignedDistance ba = diffpills::signed_distance(b, pose_b, a, pose_a);
+  check(std::isfinite(ab.distance) && std::isfinite(ba.distance), "signed distance is finite",
+        ab.distance);
+  check(ab.gradient.allFinite() && ab.points_jacobian.allFinite() &&
+            ab.core_points_jacobian.allFinite(),
+        "signed distance derivatives are finite");
+  check(ab.points[0].allFinite() && ab.points[1].allFinite(), "witness points are finite");
+  check(std::abs(ab.normal.norm() - 1.0) <= 1e-14, "signed distance normal is unit",
+        ab.normal.norm());
+  const double tolerance = 1e-10 * scene;
+  check(std::abs(ab.distance - ba.distance) <= tolerance, "swap symmetry of the signed distance",
+        ab.distance - ba.distance);
+  // Points are only representable to a few ulps of their own magnitude (a scene of size 1e70 at
+  // z = 1e100 has its points to ~1e84).
+  const double representable =
+      8 * std::numeric_limits<double>::epsilon() *
+      std::max(ab.points[0].lpNorm<Eigen::Infinity>(), ab.points[1].lpNorm<Eigen::Infinity>());
+  check((ab.points[1] - ab.points[0] - ab.distance * ab.normal).stableNorm() <=
+            tolerance + representable,
+        "points[1] - points[0] = distance * normal",
+        (ab.points[1] - ab.points[0] - ab.distance * ab.normal).stableNorm());
+  if (ab.penetrating) {
+    check(ab.distance <= -radii + tolerance, "penetrating: distance <= -(R1 + R2)", ab.distance);
+  } else {
+    // The closest points of proximity() (not phi + (R1 + R2)^2, which cancels for a gap far
+    // below the radii).
+    const double gap = (proximity.core_points[1] - proximity.core_points[0]).stableNorm();
+    check(std::abs(ab.distance + radii - gap) <= tolerance,
+          "apart: distance agrees with the proximity's closest points", ab.distance + radii - gap);
+  }
+}
+
 // Every query on one valid pair, with the invariants above.
 void check_queries(FuzzedDataProvider& data, const Shape& a, const Pose& pose_a, const Shape& b,
                    const Pose& pose_b) {
@@ -225,6 +265,8 @@ void check_queries(FuzzedDataProvider& data, const Shape& a, const Pose& pose_a,
   check_result(ba, radii);
   const double phi_tolerance = 1e-12 * scene * scene;
   check(std::abs(ab.phi - ba.phi) <= phi_tolerance, "swap symmetry of phi", ab.phi - ba.phi);
+
+  check_signed_distance(a, pose_a, b, pose_b, ab, radii, scene);
 
   const diffpills::Proximity plain = diffpills::proximity(a, pose_a, b, pose_b);
   check(plain.phi == ab.phi, "proximity and proximity_jacobian agree", plain.phi - ab.phi);

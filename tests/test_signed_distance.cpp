@@ -452,6 +452,31 @@ TEST(SignedDistance, CoplanarOverlappingSquares) {
   EXPECT_NEAR((sd.core_points[0] - Eigen::Vector3d(0.5, 0, 0)).norm(), 0.0, 1e-14);
 }
 
+// Two equal hexagons crossing at 2e-11 rad about a line through their centres: D is a thin
+// polytope, the depth ~2e-11 of their size. The edges are pairwise nearly parallel, and e x f must
+// be formed stably (fuzz_proximity found a depth of the polygons' whole size here).
+TEST(SignedDistance, NearlyCoplanarCrossingPolygons) {
+  Eigen::MatrixX2d C(6, 2);
+  for (int k = 0; k < 6; ++k) C.row(k) << std::cos(M_PI * k / 3), std::sin(M_PI * k / 3);
+  const PaddedPolygon hexagon(C, Eigen::VectorXd::Constant(6, 1.0), 0.0);
+  for (const double angle : {2e-11, 1e-9, 3e-7}) {
+    const Pose flat(Eigen::Vector3d(0.1, 0.2, 0.3), about(0.4, 0, 0, 1));
+    const Pose tilted(Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Vector4d(std::cos(angle / 2),
+                                                                      std::sin(angle / 2), 0, 0));
+    const SignedDistance ab = signed_distance(hexagon, flat, hexagon, tilted);
+    const SignedDistance ba = signed_distance(hexagon, tilted, hexagon, flat);
+    std::vector<Eigen::Vector3d> body;
+    for (const auto& v : hexagon.vertices().rowwise()) body.emplace_back(v.x(), v.y(), 0.0);
+    const TestShape shape{hexagon, body, 1.2};
+    const SignedCoreDistance hull =
+        brute_force_signed_distance(to_world(shape, flat), to_world(shape, tilted), 1.0L);
+    // Facets within the tie tolerance (1e-12 of the size) of each other count as equally deep.
+    EXPECT_NEAR(ab.distance, static_cast<double>(hull.s), 2e-12) << angle;
+    EXPECT_NEAR(ba.distance, ab.distance, 2e-12) << angle;
+    EXPECT_LT(-ab.distance, 2.0 * angle);  // about the hexagon's reach (2 / sqrt(3)) times angle
+  }
+}
+
 // Continuity across touching: a capsule moved down through a plate, the signed distance falls
 // linearly, with slope -1, before and after its end touches the face.
 TEST(SignedDistance, ContinuousAcrossTouching) {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "segment_segment.hpp"
+
 namespace diffpills::detail {
 namespace {
 
@@ -82,27 +84,25 @@ std::array<ClosestFeature, 2> face_witnesses(const DeepestFacet& facet, const Co
   return ordered(face.face_side(other.vertex(chosen) + shift), other.vertex_side(chosen));
 }
 
-// An edge-edge facet: the points of the two edges' lines whose difference is along n. With
-// a, b the unit directions, c = a x b and w = f.start - e.start, the lengths along the edges
-// solving t a - u b = w + lambda n are t = (w x b) . c / |c|^2 and u = (w x a) . c / |c|^2 (cross
-// the equation with b, or a, and take the component along c, which removes n).
+// An edge-edge facet: the points of the two edges whose difference is along n, the closest points
+// of the edges' lines, which lie on the edges for the nearest facet. They are taken from the
+// backward-stable segment solver (segment_segment.hpp), not from the normal: for nearly parallel
+// edges (angle alpha) the normal e x f / |e x f| is only known to ~1e-16 / alpha, while the closest
+// points are accurate; the caller then takes the normal from them.
 std::array<ClosestFeature, 2> edge_witnesses(const DeepestFacet& facet, const CoreOutline& a,
                                              const CoreOutline& b) {
   const OutlineEdge& e = a.edge(facet.edges[0]);
   const OutlineEdge& f = b.edge(facet.edges[1]);
-  const Eigen::Vector3d c = e.direction.cross(f.direction);
-  const Eigen::Vector3d w = f.start - e.start;
-  const double c2 = c.squaredNorm();
-  const double along_e = w.cross(f.direction).dot(c) / c2;
-  const double along_f = w.cross(e.direction).dot(c) / c2;
-  const auto parameter = [](double along, double length) {
-    return length > 0.0 ? std::clamp(along / length, 0.0, 1.0) : 0.0;
-  };
-  return {a.edge_side(facet.edges[0], parameter(along_e, e.length)),
-          b.edge_side(facet.edges[1], parameter(along_f, f.length))};
+  const SegmentParameters closest = closest_segment_parameters({e.start, e.direction, e.length},
+                                                               {f.start, f.direction, f.length});
+  return {a.edge_side(facet.edges[0], closest.s), b.edge_side(facet.edges[1], closest.t)};
 }
 
 }  // namespace
+
+Eigen::Vector3d stable_cross(const Eigen::Vector3d& e, const Eigen::Vector3d& f) {
+  return e.cross(e.dot(f) >= 0.0 ? Eigen::Vector3d(f - e) : Eigen::Vector3d(f + e));
+}
 
 DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double tolerance) {
   const Eigen::Vector3d offset = b.posed().r - a.posed().r;
@@ -126,7 +126,7 @@ DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double to
     const OutlineEdge& e = a.edge(i);
     for (Eigen::Index j = 0; j < b.edge_count(); ++j) {
       const OutlineEdge& f = b.edge(j);
-      const Eigen::Vector3d c = e.direction.cross(f.direction);
+      const Eigen::Vector3d c = stable_cross(e.direction, f.direction);
       const double sine = c.norm();
       if (sine <= kParallelSine) continue;
       const Eigen::Vector3d n = c / sine;

@@ -58,6 +58,13 @@ struct DeepestFacet {
 
 DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double tolerance);
 
+// e x f for unit vectors e and f, computed as e x (f - e) (or e x (f + e) when they point apart):
+// the same vector, but for nearly parallel e and f the difference f - e is exact and the product
+// keeps full relative accuracy, where e x f itself cancels to an error of ~1e-16 / |e x f| in
+// direction (fuzz_proximity: two polygons crossing at 2e-11 rad got a facet normal 1e-5 off and
+// a depth of the polygons' size instead of 2e-11 of it).
+Eigen::Vector3d stable_cross(const Eigen::Vector3d& e, const Eigen::Vector3d& f);
+
 // Points x1 of core 1 and x2 of core 2 on the facet with x1 - x2 = depth * normal: the point of
 // D's facet nearest the origin, split into its two cores (the middle of the set of such pairs
 // when it is not one pair: the middle of an edge's part over a face). Only for kFace and kEdges.

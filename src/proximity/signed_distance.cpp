@@ -59,7 +59,7 @@ NormalSource facet_source(const DeepestFacet& facet, const CoreOutline& a, const
       const Eigen::Vector3d e = a.edge(facet.edges[0]).direction;
       const Eigen::Vector3d f = b.edge(facet.edges[1]).direction;
       source.kind = NormalSource::Kind::kEdges;
-      source.sign = facet.normal.dot(e.cross(f)) > 0.0 ? 1.0 : -1.0;
+      source.sign = facet.normal.dot(detail::stable_cross(e, f)) > 0.0 ? 1.0 : -1.0;
       source.edge_directions = {a.posed().attitude.matrix().transpose() * e,
                                 b.posed().attitude.matrix().transpose() * f};
       break;
@@ -111,6 +111,20 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   solution.normal = facet.normal;
   if (facet.depth > frame.tolerance) {
     solution.sides = detail::facet_witnesses(facet, outline_a, outline_b, frame.tolerance);
+    if (facet.kind == DeepestFacet::Kind::kEdges) {
+      // Depth and normal from the witnesses x1 - x2 = depth * n, which are accurate also where
+      // the edges are nearly parallel and e x f is not (penetration.hpp).
+      const Eigen::Vector3d across = pa.r + pa.attitude.matrix() * solution.sides[0].body_point -
+                                     pb.r - pb.attitude.matrix() * solution.sides[1].body_point;
+      const double depth = across.norm();
+      // (Only where they agree with the facet: the lines' closest points of its nearest point lie
+      // on the edges.)
+      if (depth > frame.tolerance && across.dot(facet.normal) > 0.0 &&
+          depth <= facet.depth * (1.0 + 1e-9) + frame.tolerance) {
+        solution.gap = -depth;
+        solution.normal = across / depth;
+      }
+    }
   }
   return solution;
 }

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include "penetration.hpp"
 #include "point_motion.hpp"
 #include "unit_quaternion.hpp"
 
@@ -15,7 +16,7 @@ Matrix3x14 edge_normal_motion(const PosedCore& a, const PosedCore& b, const Norm
   Matrix3x14 d_cross = Matrix3x14::Zero();
   d_cross.middleCols<4>(3) = -skew(edge_b) * a.attitude.rotate_jacobian(source.edge_directions[0]);
   d_cross.middleCols<4>(10) = skew(edge_a) * b.attitude.rotate_jacobian(source.edge_directions[1]);
-  return source.sign * unit_vector_motion(edge_a.cross(edge_b), d_cross);
+  return source.sign * unit_vector_motion(stable_cross(edge_a, edge_b), d_cross);
 }
 
 }  // namespace
