@@ -28,6 +28,10 @@ using detail::PolygonView;
 using detail::PosedCore;
 using detail::SignedSolution;
 
+// How far the witnesses x1 - x2 may be from depth * normal, in the frame's units (where the scene's
+// size is in [1, 2)): a few thousand roundings.
+constexpr double kWitnessSlack = 1e-12;
+
 // The normal where D has no facet (parallel segments, spheres): see signed_distance.hpp. `axis`
 // is the segments' common direction, or zero for two spheres.
 Eigen::Vector3d fallback_normal(const CoreOutline& a, const CoreOutline& b, double tolerance) {
@@ -109,23 +113,27 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   }
   solution.gap = -facet.depth;
   solution.normal = facet.normal;
-  if (facet.depth > frame.tolerance) {
-    solution.sides = detail::facet_witnesses(facet, outline_a, outline_b, frame.tolerance);
-    if (facet.kind == DeepestFacet::Kind::kEdges) {
-      // Depth and normal from the witnesses x1 - x2 = depth * n, which are accurate also where
-      // the edges are nearly parallel and e x f is not (penetration.hpp).
-      const Eigen::Vector3d across = pa.r + pa.attitude.matrix() * solution.sides[0].body_point -
-                                     pb.r - pb.attitude.matrix() * solution.sides[1].body_point;
-      const double depth = across.norm();
-      // (Only where they agree with the facet: the lines' closest points of its nearest point lie
-      // on the edges.)
-      if (depth > frame.tolerance && across.dot(facet.normal) > 0.0 &&
-          depth <= facet.depth * (1.0 + 1e-9) + frame.tolerance) {
-        solution.gap = -depth;
-        solution.normal = across / depth;
-      }
-    }
+  if (facet.depth <= frame.tolerance) return solution;  // touching, or a flat D: as they are
+  const detail::Sides witnesses =
+      detail::facet_witnesses(facet, outline_a, outline_b, frame.tolerance);
+  const Eigen::Vector3d across = pa.r + pa.attitude.matrix() * witnesses[0].body_point - pb.r -
+                                 pb.attitude.matrix() * witnesses[1].body_point;
+  const double depth = across.norm();
+  if (facet.kind == DeepestFacet::Kind::kEdges && depth > frame.tolerance &&
+      across.dot(facet.normal) > 0.0 && depth <= facet.depth * (1.0 + 1e-9) + frame.tolerance) {
+    // Depth and normal from the witnesses x1 - x2 = depth * n, which are accurate also where the
+    // edges are nearly parallel and e x f is not (penetration.hpp).
+    solution.sides = witnesses;
+    solution.gap = -depth;
+    solution.normal = across / depth;
+  } else if ((across - facet.depth * facet.normal).norm() <= kWitnessSlack) {
+    solution.sides = witnesses;
   }
+  // Otherwise the facet's witnesses do not split its nearest point (a D so thin, cores crossing
+  // within ~1e-9 of coplanar, that facets a tolerance apart in depth are far apart along it, and
+  // ties chose one whose nearest point is off its parallelogram): the closest points, the middle
+  // of the cores' intersection, stand in, off the facet by the depth (found by fuzz_proximity).
+  return solution;
   return solution;
 }
 
