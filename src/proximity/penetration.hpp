@@ -19,7 +19,10 @@
 //     K1 needs n . o >= 0 and an edge of K2 (mirrored in -K2) n . o <= 0; a segment, which is
 //     its own edge, admits every n normal to it. Such a facet's h_D(n) = n . (x_e - x_f) for any
 //     points x_e, x_f of the two edges: the distance between the edges' lines.
-// A vertex plus a vertex or an edge is not 2-D, so there are no other facets. Every candidate's
+// A vertex plus a vertex or an edge is not 2-D, so there are no other facets. Edge pairs whose
+// normal lies within 1e-10 rad of a polygon's face normal are slivers beside that face's facet,
+// left to it (the depth moves by at most 1e-10 of the scene's size; their witnesses are not well
+// defined), as are edge pairs within |sin| <= 1e-12 of parallel (by at most 1e-12). Every candidate's
 // value is h_D at a facet normal, at least the depth, and the nearest facet is among them: their
 // minimum is the depth. The normal-cone tests allow 1e-12 (a cosine, so relative): a candidate
 // admitted within it is below the true h_D(n) by at most 1e-12 of the scene's size.
@@ -27,10 +30,12 @@
 // Where D is flat (two segments, a segment lying in a polygon's plane, coplanar polygons) it has
 // no interior; the candidates +-n of its plane then both give 0, the documented depth.
 //
-// Ties (values within the frame's tolerance) go to the normal pointing most from core 1's body
-// origin to core 2's, n . (r2 - r1), which turns with the scene and flips with the order of the
-// shapes; then to the one most along core 1's Q e_z; then to the first found (faces of core 1,
-// faces of core 2, edge pairs in order).
+// Ties (values within the frame's tolerance) go to a polygon's face over an edge pair (a face's
+// witnesses are well conditioned; an edge pair's nearly parallel to the face makes a sliver facet
+// whose nearest point a tolerance can move off it, found by fuzz_proximity); then to the normal
+// pointing most from core 1's body origin to core 2's, n . (r2 - r1), which turns with the scene
+// and flips with the order of the shapes; then to the one most along core 1's Q e_z; then to the
+// first found (faces of core 1, faces of core 2, edge pairs in order).
 //
 // Cost: O(m1 m2) for two polygons of m1 and m2 vertices (D has that many edge-edge facets),
 // O(m) for a segment and a polygon; nothing is allocated up to 32 vertices.

@@ -130,7 +130,7 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
     solution.sides = witnesses;
   }
   // Otherwise the facet's witnesses do not split its nearest point (a D so thin, cores crossing
-  // within ~1e-9 of coplanar, that facets a tolerance apart in depth are far apart along it, and
+  // within ~1e-8 of coplanar, that facets a tolerance apart in depth are far apart along it, and
   // ties chose one whose nearest point is off its parallelogram): the closest points, the middle
   // of the cores' intersection, stand in, off the facet by the depth (found by fuzz_proximity).
   return solution;
