@@ -228,20 +228,23 @@ void check_signed_distance(const Shape& a, const Pose& pose_a, const Shape& b, c
   check(ab.points[0].allFinite() && ab.points[1].allFinite(), "witness points are finite");
   check(std::abs(ab.normal.norm() - 1.0) <= 1e-14, "signed distance normal is unit",
         ab.normal.norm());
-  const double tolerance = 1e-10 * scene;
-  check(std::abs(ab.distance - ba.distance) <= tolerance, "swap symmetry of the signed distance",
-        ab.distance - ba.distance);
-  // Points are only representable to a few ulps of their own magnitude (a scene of size 1e70 at
-  // z = 1e100 has its points to ~1e84).
+  // (With a floor of a few subnormals: a scene of subnormal numbers has a tolerance of zero.)
+  const double tolerance = 1e-10 * scene + 8 * std::numeric_limits<double>::denorm_min();
+  // World points are only representable to a few ulps of their own magnitude (a scene of size 1e70
+  // at z = 1e100 has its points to ~1e84), and so is anything computed from them.
   const double representable =
       8 * std::numeric_limits<double>::epsilon() *
-      std::max(ab.points[0].lpNorm<Eigen::Infinity>(), ab.points[1].lpNorm<Eigen::Infinity>());
-  // In penetrations thinner than 1e-8 of the scene the witnesses may be the closest points, off
-  // the facet by the depth (signed_distance.hpp).
-  const double depth = ab.penetrating ? -(ab.distance + radii) : 0.0;
-  const double thin = depth <= 1e-8 * scene ? std::abs(depth) : 0.0;
+      std::max({ab.points[0].lpNorm<Eigen::Infinity>(), ab.points[1].lpNorm<Eigen::Infinity>(),
+                proximity.core_points[0].lpNorm<Eigen::Infinity>(),
+                proximity.core_points[1].lpNorm<Eigen::Infinity>()});
+  check(std::abs(ab.distance - ba.distance) <= tolerance, "swap symmetry of the signed distance",
+        ab.distance - ba.distance);
+
+  // In penetration the witnesses may be the closest points, off the facet by the depth (a known
+  // limitation, signed_distance.hpp).
+  const double depth = ab.penetrating ? std::abs(ab.distance + radii) : 0.0;
   check((ab.points[1] - ab.points[0] - ab.distance * ab.normal).stableNorm() <=
-            tolerance + representable + thin,
+            tolerance + representable + depth,
         "points[1] - points[0] = distance * normal",
         (ab.points[1] - ab.points[0] - ab.distance * ab.normal).stableNorm());
   if (ab.penetrating) {
@@ -250,7 +253,7 @@ void check_signed_distance(const Shape& a, const Pose& pose_a, const Shape& b, c
     // The closest points of proximity() (not phi + (R1 + R2)^2, which cancels for a gap far
     // below the radii).
     const double gap = (proximity.core_points[1] - proximity.core_points[0]).stableNorm();
-    check(std::abs(ab.distance + radii - gap) <= tolerance,
+    check(std::abs(ab.distance + radii - gap) <= tolerance + representable,
           "apart: distance agrees with the proximity's closest points", ab.distance + radii - gap);
   }
 }

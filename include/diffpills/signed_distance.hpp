@@ -43,11 +43,11 @@
 //   - Penetrating facets that tie (a capsule through a polygon's centre, equally deep both ways)
 //     are decided by the same rule; the normal then jumps as the configuration leaves the tie,
 //     and the gradient is that of the chosen facet (one-sided).
-//   - Cores crossing within ~1e-8 rad of coplanar have a D so thin that facets a tolerance apart
-//     in depth lie far apart along it; where the chosen facet's witnesses do not split its
-//     nearest point, the closest points (the middle of the cores' intersection) stand in, and
-//     points[1] - points[0] = distance * normal holds only to the depth (itself ~1e-8 of the
-//     scene's size or less).
+//   - Known limitation (open, issue 10): where cores cross nearly coplanar (within ~1e-4 rad, as
+//     fuzzing found), facets a tolerance apart in depth can lie far apart along D, and the
+//     chosen facet's witnesses may not split its nearest point. The closest points (the middle
+//     of the cores' intersection) then stand in: distance, normal and gradient are still those
+//     of the facet, but points[1] - points[0] = distance * normal holds only to the depth.
 //   - Tolerances are relative (1e-12 of the scene's size), as for proximity(), and every input
 //     proximity() accepts is answered at every magnitude; scaling all lengths by 2^k scales
 //     distance and the points by 2^k, the gradient's quaternion part by 2^k, exactly.

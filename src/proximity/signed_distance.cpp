@@ -129,11 +129,11 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   } else if ((across - facet.depth * facet.normal).norm() <= kWitnessSlack) {
     solution.sides = witnesses;
   }
-  // Otherwise the facet's witnesses do not split its nearest point (a D so thin, cores crossing
-  // within ~1e-8 of coplanar, that facets a tolerance apart in depth are far apart along it, and
-  // ties chose one whose nearest point is off its parallelogram): the closest points, the middle
-  // of the cores' intersection, stand in, off the facet by the depth (found by fuzz_proximity).
-  return solution;
+  // Otherwise the facet's witnesses do not split its nearest point (cores crossing nearly
+  // coplanar: facets a tolerance apart in depth lie far apart along a thin D, and the chosen one's
+  // nearest point is off its parallelogram; found by fuzz_proximity, see signed_distance.hpp):
+  // the closest points, the middle of the cores' intersection, stand in, off the facet by the
+  // depth.
   return solution;
 }
 
