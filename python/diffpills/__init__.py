@@ -9,11 +9,14 @@ Shapes: ``Capsule(length, radius)`` and ``PaddedPolygon(C, d, radius)``, each po
     the same plus the Jacobians (6, 14) of the closest points.
 ``proximity_batch(a, r_a, q_a, b, r_b, q_b, threads=0)``
     phi (N,) and gradients (N, 14) for arrays of poses, on every core, without the GIL.
+``signed_distance(a, pose_a, b, pose_b)``, ``signed_distance_jacobian``, ``signed_distance_batch``
+    the signed distance (the gap, or minus the penetration depth) with its exact gradient, which
+    keeps a slope where phi is flat (overlapping cores).
 
 ``phi = ||p1 - p2||^2 - (R1 + R2)^2`` is negative exactly when the shapes overlap. Bad input raises
 ValueError (a bad value or shape) or TypeError (a wrong type: complex numbers, a str, a tensor that
-requires grad) naming the field. ``import diffpills.torch`` for ``diffpills.torch.proximity``, a
-PyTorch autograd function over batches (not imported here, so that ``import diffpills`` stays fast
+requires grad) naming the field. ``import diffpills.torch`` for ``diffpills.torch.proximity`` and
+``diffpills.torch.signed_distance``, PyTorch autograd functions over batches (not imported here, so that ``import diffpills`` stays fast
 without PyTorch).
 """
 
@@ -23,11 +26,16 @@ from ._core import (
     Pose,
     Proximity,
     ProximityJacobian,
+    SignedDistance,
+    SignedDistanceJacobian,
     SolverError,
     __version__,
     proximity,
     proximity_batch,
     proximity_jacobian,
+    signed_distance,
+    signed_distance_batch,
+    signed_distance_jacobian,
 )
 
 __all__ = [
@@ -36,9 +44,14 @@ __all__ = [
     "Pose",
     "Proximity",
     "ProximityJacobian",
+    "SignedDistance",
+    "SignedDistanceJacobian",
     "SolverError",
     "__version__",
     "proximity",
     "proximity_batch",
     "proximity_jacobian",
+    "signed_distance",
+    "signed_distance_batch",
+    "signed_distance_jacobian",
 ]

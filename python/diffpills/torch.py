@@ -1,4 +1,5 @@
-"""PyTorch autograd for diffpills: ``diffpills.torch.proximity`` over batches of poses.
+"""PyTorch autograd for diffpills: ``diffpills.torch.proximity`` and
+``diffpills.torch.signed_distance`` over batches of poses.
 
     import torch, diffpills, diffpills.torch
     capsule = diffpills.Capsule(1.0, 0.2)
@@ -18,7 +19,7 @@ import torch
 
 from . import _core
 
-__all__ = ["proximity"]
+__all__ = ["proximity", "signed_distance"]
 
 
 def _refuse_second_derivatives():
@@ -37,23 +38,17 @@ def _as_numpy(tensor):
     return np.ascontiguousarray(tensor.detach().to(device="cpu", dtype=torch.float64).numpy())
 
 
-class _Proximity(torch.autograd.Function):
-    """phi of N pose pairs, with backward through the analytic gradient."""
+class _Batch(torch.autograd.Function):
+    """A value of N pose pairs (phi or the signed distance), with backward through the analytic
+    gradient. ``batch`` is the diffpills batch function, called with keyword ``options``."""
 
     @staticmethod
-    def forward(ctx, a, b, threads, method, r_a, q_a, r_b, q_b):
-        phi, gradient = _core.proximity_batch(
-            a,
-            _as_numpy(r_a),
-            _as_numpy(q_a),
-            b,
-            _as_numpy(r_b),
-            _as_numpy(q_b),
-            threads=threads,
-            method=method,
+    def forward(ctx, batch, a, b, options, r_a, q_a, r_b, q_b):
+        value, gradient = batch(
+            a, _as_numpy(r_a), _as_numpy(q_a), b, _as_numpy(r_b), _as_numpy(q_b), **options
         )
         ctx.save_for_backward(torch.from_numpy(gradient).to(device=r_a.device, dtype=r_a.dtype))
-        return torch.from_numpy(phi).to(device=r_a.device, dtype=r_a.dtype)
+        return torch.from_numpy(value).to(device=r_a.device, dtype=r_a.dtype)
 
     @staticmethod
     def backward(ctx, grad_phi):
@@ -97,6 +92,22 @@ def proximity(a, r_a, q_a, b, r_b, q_b, threads=0, method="default"):
     Raises ValueError for bad shapes or values, TypeError for wrong types (naming the argument,
     and the row of a bad value).
     """
+    options = {"threads": threads, "method": method}
+    return _apply(_core.proximity_batch, a, b, options, r_a, q_a, r_b, q_b)
+
+
+def signed_distance(a, r_a, q_a, b, r_b, q_b, threads=0):
+    """The signed distance (N,) of shape ``a`` at poses (r_a[i], q_a[i]) and ``b`` at
+    (r_b[i], q_b[i]): the gap between the padded surfaces, or minus their penetration depth.
+
+    Arguments, broadcasting of single poses, dtypes, devices and errors as for ``proximity``.
+    Differentiable with respect to all four through the exact gradient, which keeps a slope where
+    phi is flat (overlapping cores): the measure to push overlapping shapes apart.
+    """
+    return _apply(_core.signed_distance_batch, a, b, {"threads": threads}, r_a, q_a, r_b, q_b)
+
+
+def _apply(batch, a, b, options, r_a, q_a, r_b, q_b):
     r_a, q_a = _rows("r_a", r_a, 3), _rows("q_a", q_a, 4)
     r_b, q_b = _rows("r_b", r_b, 3), _rows("q_b", q_b, 4)
     tensors = {"r_a": r_a, "q_a": q_a, "r_b": r_b, "q_b": q_b}
@@ -117,4 +128,4 @@ def proximity(a, r_a, q_a, b, r_b, q_b, threads=0, method="default"):
             raise ValueError(f"{name}: has {tensor.shape[0]} rows, {n_from} has {n}")
     # expand() is a view whose backward sums over the shared rows.
     r_a, q_a, r_b, q_b = (t.expand(n, t.shape[1]) for t in (r_a, q_a, r_b, q_b))
-    return _Proximity.apply(a, b, threads, method, r_a, q_a, r_b, q_b)
+    return _Batch.apply(batch, a, b, options, r_a, q_a, r_b, q_b)

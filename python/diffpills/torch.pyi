@@ -15,3 +15,12 @@ def proximity(
     threads: int = 0,
     method: Literal["default", "interior_point"] = "default",
 ) -> torch.Tensor: ...
+def signed_distance(
+    a: Shape,
+    r_a: torch.Tensor,
+    q_a: torch.Tensor,
+    b: Shape,
+    r_b: torch.Tensor,
+    q_b: torch.Tensor,
+    threads: int = 0,
+) -> torch.Tensor: ...

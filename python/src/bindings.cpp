@@ -37,6 +37,8 @@ inline std::string not_constructed(const py::handle& object) {
   return "this diffpills." + type + " was made by __new__ without __init__ and holds no value; " +
          (py::isinstance<Proximity>(object)
               ? "results come from diffpills.proximity and proximity_jacobian"
+          : py::isinstance<SignedDistance>(object)
+              ? "results come from diffpills.signed_distance and signed_distance_jacobian"
               : "create it as diffpills." + type + "(...)");
 }
 
@@ -71,6 +73,12 @@ class type_caster<diffpills::Proximity>
 template <>
 class type_caster<diffpills::ProximityJacobian>
     : public diffpills::python::ConstructedCaster<diffpills::ProximityJacobian> {};
+template <>
+class type_caster<diffpills::SignedDistance>
+    : public diffpills::python::ConstructedCaster<diffpills::SignedDistance> {};
+template <>
+class type_caster<diffpills::SignedDistanceJacobian>
+    : public diffpills::python::ConstructedCaster<diffpills::SignedDistanceJacobian> {};
 }  // namespace pybind11::detail
 
 namespace diffpills::python {
@@ -453,6 +461,85 @@ void restore_proximity(Proximity& p, const py::handle& state) {
   p.gradient = fixed_vector<14>(fields[5], "gradient");
 }
 
+py::object signed_distance_state(const SignedDistance& s) {
+  return py::make_tuple(s.distance, points_array(s.core_points), points_array(s.points), s.normal,
+                        s.penetrating, s.gradient);
+}
+
+constexpr const char* kSignedDistanceFields =
+    "(distance, core_points, points, normal, penetrating, gradient)";
+
+void restore_signed_distance(SignedDistance& s, const py::handle& state) {
+  const py::tuple fields = pickled_state(state, 6, kSignedDistanceFields);
+  s.distance = real_number(fields[0], "distance");
+  s.core_points = points_from(fields[1], "core_points");
+  s.points = points_from(fields[2], "points");
+  s.normal = fixed_vector<3>(fields[3], "normal");
+  py::detail::make_caster<bool> penetrating;
+  if (!penetrating.load(fields[4], /*convert=*/false)) {
+    throw py::type_error("penetrating: expected a bool, got " + type_name(fields[4]));
+  }
+  s.penetrating = static_cast<bool>(penetrating);
+  s.gradient = fixed_vector<14>(fields[5], "gradient");
+}
+
+void bind_signed_distance_results(py::module_& m) {
+  py::class_<SignedDistance>(m, "SignedDistance", R"(The result of diffpills.signed_distance.
+
+distance     the gap between the padded surfaces (> 0), or minus their penetration depth (< 0)
+core_points  (2, 3): witness points on the two cores, world frame
+points       (2, 3): witness points on the two surfaces; points[1] - points[0] = distance * normal
+normal       (3,): unit, from shape a to shape b; moving b by -distance * normal makes them touch
+penetrating  True when the cores intersect
+gradient     (14,): d distance / d[r_a, q_a, r_b, q_b])")
+      .def_readonly("distance", &SignedDistance::distance)
+      .def_property_readonly("core_points",
+                             [](const SignedDistance& s) { return points_array(s.core_points); })
+      .def_property_readonly("points",
+                             [](const SignedDistance& s) { return points_array(s.points); })
+      .def_readonly("normal", &SignedDistance::normal)
+      .def_readonly("penetrating", &SignedDistance::penetrating)
+      .def_readonly("gradient", &SignedDistance::gradient)
+      .def("__repr__",
+           [](const SignedDistance& s) {
+             std::ostringstream out;
+             out << "diffpills.SignedDistance(distance=" << s.distance << ", normal=["
+                 << s.normal.transpose() << "], penetrating=" << (s.penetrating ? "True" : "False")
+                 << ")";
+             return out.str();
+           })
+      .def(py::pickle(&signed_distance_state, [](const py::object& state) {
+        SignedDistance s;
+        restore_signed_distance(s, state);
+        return s;
+      }));
+
+  py::class_<SignedDistanceJacobian, SignedDistance>(
+      m, "SignedDistanceJacobian", R"(The result of diffpills.signed_distance_jacobian: everything
+of SignedDistance, plus
+
+core_points_jacobian  (6, 14): d[core point a; core point b] / d[r_a, q_a, r_b, q_b]
+points_jacobian       (6, 14): d[surface point a; surface point b] / d[r_a, q_a, r_b, q_b])")
+      .def_readonly("core_points_jacobian", &SignedDistanceJacobian::core_points_jacobian)
+      .def_readonly("points_jacobian", &SignedDistanceJacobian::points_jacobian)
+      .def(py::pickle(
+          [](const SignedDistanceJacobian& s) -> py::object {
+            return py::make_tuple(signed_distance_state(s), s.core_points_jacobian,
+                                  s.points_jacobian);
+          },
+          [](const py::object& state) {
+            const py::tuple fields =
+                pickled_state(state, 3,
+                              std::string("(") + kSignedDistanceFields +
+                                  ", core_points_jacobian, " + "points_jacobian)");
+            SignedDistanceJacobian s;
+            restore_signed_distance(s, fields[0]);
+            s.core_points_jacobian = fixed_matrix<6, 14>(fields[1], "core_points_jacobian");
+            s.points_jacobian = fixed_matrix<6, 14>(fields[2], "points_jacobian");
+            return s;
+          }));
+}
+
 void bind_results(py::module_& m) {
   py::class_<Proximity>(m, "Proximity", R"(The result of diffpills.proximity.
 
@@ -505,20 +592,29 @@ points_jacobian       (6, 14): d[surface point a; surface point b] / d[r_a, q_a,
             p.points_jacobian = fixed_matrix<6, 14>(fields[2], "points_jacobian");
             return p;
           }));
+  bind_signed_distance_results(m);
 }
 
-// proximity / proximity_jacobian on two shapes of any type.
+// A query of two shapes of any type: call(shape_a, pose_a, shape_b, pose_b).
 template <class Result, class Query>
-Result query(const py::handle& a, const py::handle& pose_a, const py::handle& b,
-             const py::handle& pose_b, const py::handle& method, const Query& call) {
-  const ProximityOptions options{to_method(method)};
+Result pair_query(const py::handle& a, const py::handle& pose_a, const py::handle& b,
+                  const py::handle& pose_b, const Query& call) {
   const Pose& first = to_pose(pose_a, "pose_a");
   const Pose& second = to_pose(pose_b, "pose_b");
   return with_shape(a, "a", [&](const auto& shape_a) -> Result {
     return with_shape(b, "b", [&](const auto& shape_b) -> Result {
-      return call(shape_a, first, shape_b, second, options);
+      return call(shape_a, first, shape_b, second);
     });
   });
+}
+
+// proximity / proximity_jacobian, with the method.
+template <class Result, class Query>
+Result query(const py::handle& a, const py::handle& pose_a, const py::handle& b,
+             const py::handle& pose_b, const py::handle& method, const Query& call) {
+  const ProximityOptions options{to_method(method)};
+  return pair_query<Result>(a, pose_a, b, pose_b,
+                            [&](const auto&... args) { return call(args..., options); });
 }
 
 // A caller-owned output array: float64, C-contiguous, writable, of the given shape (no silent
@@ -550,10 +646,12 @@ bool overlap(const py::array& x, const py::array& y) {
          y_begin < x_begin + x.nbytes();
 }
 
-py::tuple batch(const py::handle& a, const py::handle& r_a, const py::handle& q_a,
-                const py::handle& b, const py::handle& r_b, const py::handle& q_b,
-                const py::handle& threads, const py::handle& method, const py::handle& out) {
-  const BatchOptions options{thread_count(threads), to_method(method)};
+// The batch of either query (value = phi or distance): run(shape_a, r_a, q_a, shape_b, r_b, q_b,
+// value, gradient) fills the outputs, without the GIL.
+template <class Run>
+py::tuple batch_of(const char* value_name, const py::handle& a, const py::handle& r_a,
+                   const py::handle& q_a, const py::handle& b, const py::handle& r_b,
+                   const py::handle& q_b, const py::handle& out, const Run& run) {
   const Shape shape_a = to_shape(a, "a"), shape_b = to_shape(b, "b");
   BatchInput<3> r_first(r_a, "r_a"), r_second(r_b, "r_b");
   BatchInput<4> q_first(q_a, "q_a"), q_second(q_b, "q_b");
@@ -582,12 +680,17 @@ py::tuple batch(const py::handle& a, const py::handle& r_a, const py::handle& q_
     gradient = py::array_t<double>({n, static_cast<Eigen::Index>(14)});
   } else {
     if (!py::isinstance<py::tuple>(out)) {
-      throw py::type_error("out: expected a tuple (phi, gradient), got " + type_name(out));
+      throw py::type_error("out: expected a tuple (" + std::string(value_name) +
+                           ", gradient), got " + type_name(out));
     }
-    if (py::len(out) != 2) throw py::value_error("out: expected a tuple (phi, gradient)");
+    if (py::len(out) != 2) {
+      throw py::value_error("out: expected a tuple (" + std::string(value_name) + ", gradient)");
+    }
     phi = output_array(out[py::int_(0)], "out[0]", {n});
     gradient = output_array(out[py::int_(1)], "out[1]", {n, 14});
-    if (overlap(phi, gradient)) throw py::value_error("out: phi and gradient share memory");
+    if (overlap(phi, gradient)) {
+      throw py::value_error("out: " + std::string(value_name) + " and gradient share memory");
+    }
     for (const auto* input :
          {&r_first.array(), &q_first.array(), &r_second.array(), &q_second.array()}) {
       for (auto [output, name] : {std::pair{&phi, "out[0]"}, {&gradient, "out[1]"}}) {
@@ -601,9 +704,26 @@ py::tuple batch(const py::handle& a, const py::handle& r_a, const py::handle& q_
   Eigen::Map<GradientArray> gradient_view(gradient.mutable_data(), n, 14);
   {
     py::gil_scoped_release release;
-    proximity_batch(shape_a, ra, qa, shape_b, rb, qb, phi_view, gradient_view, options);
+    run(shape_a, ra, qa, shape_b, rb, qb, phi_view, gradient_view);
   }
   return py::make_tuple(phi, gradient);
+}
+
+py::tuple batch(const py::handle& a, const py::handle& r_a, const py::handle& q_a,
+                const py::handle& b, const py::handle& r_b, const py::handle& q_b,
+                const py::handle& threads, const py::handle& method, const py::handle& out) {
+  const BatchOptions options{thread_count(threads), to_method(method)};
+  return batch_of("phi", a, r_a, q_a, b, r_b, q_b, out,
+                  [&](const auto&... args) { proximity_batch(args..., options); });
+}
+
+py::tuple signed_distance_batch_of(const py::handle& a, const py::handle& r_a,
+                                   const py::handle& q_a, const py::handle& b,
+                                   const py::handle& r_b, const py::handle& q_b,
+                                   const py::handle& threads, const py::handle& out) {
+  const BatchOptions options{thread_count(threads)};
+  return batch_of("distance", a, r_a, q_a, b, r_b, q_b, out,
+                  [&](const auto&... args) { signed_distance_batch(args..., options); });
 }
 
 }  // namespace
@@ -622,6 +742,9 @@ quaternion [w, x, y, z]. For any pair:
   proximity_batch(a, r_a, q_a, b, r_b, q_b, threads=0)
                                             phi (N,) and gradients (N, 14) for arrays of poses,
                                             on all cores, without the GIL
+  signed_distance(a, pose_a, b, pose_b)     the signed distance (negative in penetration), its
+                                            witness points, normal and gradient (14,); also
+                                            signed_distance_jacobian and signed_distance_batch
 
 phi = ||p1 - p2||^2 - (R1 + R2)^2 is negative exactly when the shapes overlap. The gradient layout
 is [r_a (3), q_a (4), r_b (3), q_b (4)]. method="interior_point" selects the paper's solver
@@ -630,8 +753,9 @@ shape) or TypeError (a wrong type: a str, complex numbers, an object made by __n
 the field; import diffpills.torch for a PyTorch autograd function over batches.)";
   m.attr("__version__") = kVersion;
   py::register_exception<SolverError>(m, "SolverError", PyExc_RuntimeError).attr("__doc__") =
-      "Raised when the QP solver does not converge (never seen for valid shapes in the tests); "
-      "the library never returns an unverified answer.";
+      "Raised when the interior-point method (method=\"interior_point\") does not converge, which "
+      "it can fail to on badly scaled pairs; the default method never raises it, and the library "
+      "never returns an unverified answer.";
   bind_shapes(m);
   bind_results(m);
 
@@ -676,4 +800,34 @@ released while they run. A bad row raises ValueError naming it, e.g. "q_b[17]: .
 out: optionally (phi, gradient), writable float64 C-contiguous arrays of shapes (N,) and (N, 14),
 sharing no memory with each other or the inputs, to write into and return, for loops that call the batch repeatedly (fresh outputs cost page faults, which
 the kernel serializes across threads: measured 1.5x slower with 2 threads for 10^5 capsules).)");
+
+  m.def(
+      "signed_distance",
+      [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
+         const py::handle& pose_b) {
+        return pair_query<SignedDistance>(
+            a, pose_a, b, pose_b, [](const auto&... args) { return signed_distance(args...); });
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
+      R"(Signed distance of shape a at pose_a and shape b at pose_b: the gap between the padded
+surfaces, or minus their penetration depth, with its exact gradient on both sides.
+
+Returns a SignedDistance: distance, core_points (2, 3), points (2, 3), normal (3,), penetrating and
+gradient (14,) = d distance / d[r_a, q_a, r_b, q_b].)");
+  m.def(
+      "signed_distance_jacobian",
+      [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
+         const py::handle& pose_b) {
+        return pair_query<SignedDistanceJacobian>(a, pose_a, b, pose_b, [](const auto&... args) {
+          return signed_distance_jacobian(args...);
+        });
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
+      R"(As signed_distance, plus core_points_jacobian and points_jacobian (6, 14).)");
+  m.def("signed_distance_batch", &signed_distance_batch_of, py::arg("a"), py::arg("r_a"),
+        py::arg("q_a"), py::arg("b"), py::arg("r_b"), py::arg("q_b"), py::arg("threads") = 0,
+        py::arg("out") = py::none(),
+        R"(The signed distance and its gradient for N pose pairs of one shape pair: as
+proximity_batch (arrays, single poses, threads, out=, errors), returning (distance (N,),
+gradient (N, 14)), row i equal to signed_distance(a, Pose(r_a[i], q_a[i]), b, Pose(r_b[i], q_b[i])).)");
 }
