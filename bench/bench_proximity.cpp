@@ -189,6 +189,23 @@ BENCHMARK(CapsulePolygon_Vertices)
     ->Complexity()
     ->Unit(benchmark::kMicrosecond);
 
+// Nearly parallel faces (a hostile review's stall): two unit-circumradius k-gons, one 0.5 above
+// the other and tilted 1e-11 rad about x, so that thousands of vertices of each tie within the
+// windows' margin and the windows' pairs are swept (separated_polygons.cpp).
+void PolygonPolygon_NearlyParallel(benchmark::State& state) {
+  const auto count = static_cast<int>(state.range(0));
+  const PaddedPolygon polygon = regular_polygon(count, 1.0, 0.0);
+  const Pose below, above({0, 0, 0.5}, {std::cos(0.5e-11), std::sin(0.5e-11), 0, 0});
+  for (auto _ : state) benchmark::DoNotOptimize(proximity(polygon, below, polygon, above));
+  state.SetComplexityN(count);
+}
+BENCHMARK(PolygonPolygon_NearlyParallel)
+    ->RangeMultiplier(4)
+    ->Range(1024, 65536)
+    ->Arg(100000)
+    ->Complexity()
+    ->Unit(benchmark::kMillisecond);
+
 // proximity_batch over 10^5 pose pairs with 1 and 2 threads (wall-clock time).
 constexpr Eigen::Index kBatch = 100000;
 
