@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "diffpills/diffpills.hpp"
+#include "support/fcl_pose.hpp"
 #include "support/random_shapes.hpp"
 #include "support/reference.hpp"
 
@@ -118,16 +119,6 @@ TEST(ProximityReference, InteriorPointMethodAgreesWithBruteForce) {
   run_random_pairs({Method::kInteriorPoint}, 300, 7, "interior_point");
 }
 
-// FCL's capsule axis is its body z; ours is body x. R_y(+90 deg) maps z to x.
-fcl::Transform3d fcl_transform(const Pose& pose) {
-  const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
-  fcl::Transform3d transform = fcl::Transform3d::Identity();
-  transform.linear() = q.normalized().toRotationMatrix() *
-                       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  transform.translation() = pose.r();
-  return transform;
-}
-
 TEST(ProximityReference, CapsulePairsAgreeWithFcl) {
   Rng rng(99);
   double worst = 0.0;
@@ -149,7 +140,8 @@ TEST(ProximityReference, CapsulePairsAgreeWithFcl) {
       fcl::Capsuled fb(cb.radius(), cb.length());
       fcl::DistanceRequestd request;
       fcl::DistanceResultd result;
-      fcl::distance(&fa, fcl_transform(pose_a), &fb, fcl_transform(pose_b), request, result);
+      fcl::distance(&fa, fcl_capsule_transform(pose_a), &fb, fcl_capsule_transform(pose_b), request,
+                    result);
       const double fcl_core_distance = result.min_distance + ca.radius() + cb.radius();
       const double error = std::abs(fcl_core_distance - core_distance) / scale;
       worst = std::max(worst, error);

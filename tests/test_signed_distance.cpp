@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "diffpills/diffpills.hpp"
+#include "support/fcl_pose.hpp"
 #include "support/random_shapes.hpp"
 #include "support/reference.hpp"
 #include "support/scene_helpers.hpp"
@@ -139,15 +140,7 @@ TEST(SignedDistance, AgreesWithBruteForceHullOnTenThousandPairs) {
 // segments have a flat D, so s = |p1 - p2| >= 0): the same as ours. Apart, FCL's own capsule
 // distance is exact; for overlapping capsules FCL 0.7 offers only its libccd GJK/EPA, which
 // stops at a tolerance of 1e-6 (asked for 1e-12, its EPA asserts), so agreement is to that.
-constexpr double kFclSignedTolerance = 1e-5;        // 1e-6 seen
-fcl::Transform3d fcl_transform(const Pose& pose) {  // FCL's capsule axis is z, ours is x
-  const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
-  fcl::Transform3d transform = fcl::Transform3d::Identity();
-  transform.linear() = q.normalized().toRotationMatrix() *
-                       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  transform.translation() = pose.r();
-  return transform;
-}
+constexpr double kFclSignedTolerance = 1e-5;  // 1e-6 seen
 
 TEST(SignedDistance, CapsulePairsAgreeWithFcl) {
   Rng rng(5);
@@ -163,7 +156,8 @@ TEST(SignedDistance, CapsulePairsAgreeWithFcl) {
     fcl::DistanceRequestd request;
     request.enable_signed_distance = ours.distance < 0.0;
     fcl::DistanceResultd result;
-    fcl::distance(&fa, fcl_transform(c.pose_a), &fb, fcl_transform(c.pose_b), request, result);
+    fcl::distance(&fa, fcl_capsule_transform(c.pose_a), &fb, fcl_capsule_transform(c.pose_b),
+                  request, result);
     const double error = std::abs(ours.distance - result.min_distance);
     if (ours.distance < 0.0) {
       ++overlapping;
@@ -461,8 +455,8 @@ TEST(SignedDistance, NearlyCoplanarCrossingPolygons) {
   const PaddedPolygon hexagon(C, Eigen::VectorXd::Constant(6, 1.0), 0.0);
   for (const double angle : {2e-11, 1e-9, 3e-7}) {
     const Pose flat(Eigen::Vector3d(0.1, 0.2, 0.3), about(0.4, 0, 0, 1));
-    const Pose tilted(Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Vector4d(std::cos(angle / 2),
-                                                                      std::sin(angle / 2), 0, 0));
+    const Pose tilted(Eigen::Vector3d(0.1, 0.2, 0.3),
+                      Eigen::Vector4d(std::cos(angle / 2), std::sin(angle / 2), 0, 0));
     const SignedDistance ab = signed_distance(hexagon, flat, hexagon, tilted);
     const SignedDistance ba = signed_distance(hexagon, tilted, hexagon, flat);
     std::vector<Eigen::Vector3d> body;

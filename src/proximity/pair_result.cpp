@@ -90,14 +90,12 @@ ProximityJacobian make_proximity_jacobian(const PairFrame& frame, const Pose& po
   const Eigen::Vector3d p1 = a.r + a.attitude.matrix() * side_a.body_point;
   const Eigen::Vector3d p2 = b.r + b.attitude.matrix() * side_b.body_point;
 
-  Matrix3x14 dp1 = fixed_point_jacobian(a, side_a, 0);
-  Matrix3x14 dp2 = fixed_point_jacobian(b, side_b, 7);
-  add_point_motion(a, side_a, b, side_b, p1 - p2, dp1, dp2);
+  const PointMotion motion = core_point_motion(a, side_a, b, side_b);
 
   Matrix3x14 dnormal = Matrix3x14::Zero();
   switch (normal_rule(frame, a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
-      dnormal = unit_vector_motion(p2 - p1, dp2 - dp1);
+      dnormal = unit_vector_motion(p2 - p1, motion.dp2 - motion.dp1);
       break;
     case NormalRule::kOrigins: {
       Matrix3x14 d_origins = Matrix3x14::Zero();  // d(r2 - r1)
@@ -110,15 +108,8 @@ ProximityJacobian make_proximity_jacobian(const PairFrame& frame, const Pose& po
       dnormal.block<3, 4>(0, 3) = a.attitude.rotate_jacobian(Eigen::Vector3d::UnitZ());
       break;
   }
-  result.core_points_jacobian.topRows<3>() = dp1;
-  result.core_points_jacobian.bottomRows<3>() = dp2;
-  result.points_jacobian.topRows<3>() = dp1 + a.radius * dnormal;
-  result.points_jacobian.bottomRows<3>() = dp2 - b.radius * dnormal;
-  // d/dr is free of units (a length per length), d/dq is a length: the quaternion columns scale.
-  for (const int column : {3, 10}) {
-    result.core_points_jacobian.middleCols<4>(column) *= frame.scale;
-    result.points_jacobian.middleCols<4>(column) *= frame.scale;
-  }
+  point_jacobians(frame.scale, a, b, motion, dnormal, result.core_points_jacobian,
+                  result.points_jacobian);
   return result;
 }
 

@@ -88,6 +88,29 @@ void add_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedC
   }
 }
 
+PointMotion core_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
+                              const ClosestFeature& sb) {
+  PointMotion motion{fixed_point_jacobian(a, sa, 0), fixed_point_jacobian(b, sb, 7)};
+  const Eigen::Vector3d p1 = a.r + a.attitude.matrix() * sa.body_point;
+  const Eigen::Vector3d p2 = b.r + b.attitude.matrix() * sb.body_point;
+  add_point_motion(a, sa, b, sb, p1 - p2, motion.dp1, motion.dp2);
+  return motion;
+}
+
+void point_jacobians(double scale, const PosedCore& a, const PosedCore& b,
+                     const PointMotion& motion, const Matrix3x14& dnormal,
+                     Eigen::Matrix<double, 6, 14>& core_points_jacobian,
+                     Eigen::Matrix<double, 6, 14>& points_jacobian) {
+  core_points_jacobian.topRows<3>() = motion.dp1;
+  core_points_jacobian.bottomRows<3>() = motion.dp2;
+  points_jacobian.topRows<3>() = motion.dp1 + a.radius * dnormal;
+  points_jacobian.bottomRows<3>() = motion.dp2 - b.radius * dnormal;
+  for (const int column : {3, 10}) {
+    core_points_jacobian.middleCols<4>(column) *= scale;
+    points_jacobian.middleCols<4>(column) *= scale;
+  }
+}
+
 // Applied as (dv - n (n' dv)) / |v|: no 3 x 3 matrix.
 Matrix3x14 unit_vector_motion(const Eigen::Vector3d& v, const Matrix3x14& dv) {
   const double inverse_length = 1.0 / v.norm();

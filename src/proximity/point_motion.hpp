@@ -23,6 +23,22 @@ void add_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedC
                       const ClosestFeature& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
                       Matrix3x14& dp2);
 
+// The motion of the pair's two core points: fixed_point_jacobian of each side plus the motion
+// along their features (add_point_motion).
+struct PointMotion {
+  Matrix3x14 dp1, dp2;
+};
+PointMotion core_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
+                              const ClosestFeature& sb);
+
+// The results' 6x14 Jacobians of [p1; p2] and of the surface points [p1 + R1 n; p2 - R2 n], given
+// the normal's motion, in the inputs' units: d/dr is free of units (a length per length), d/dq is
+// a length, so the quaternion columns are multiplied by the frame's scale.
+void point_jacobians(double scale, const PosedCore& a, const PosedCore& b,
+                     const PointMotion& motion, const Matrix3x14& dnormal,
+                     Eigen::Matrix<double, 6, 14>& core_points_jacobian,
+                     Eigen::Matrix<double, 6, 14>& points_jacobian);
+
 // d(v / |v|) for dv: (I - n n') / |v| dv.
 Matrix3x14 unit_vector_motion(const Eigen::Vector3d& v, const Matrix3x14& dv);
 

@@ -56,14 +56,12 @@ SignedDistanceJacobian make_signed_distance_jacobian(const PairFrame& frame, con
   const auto& [side_a, side_b] = solution.sides;
   const Eigen::Vector3d x1 = a.r + a.attitude.matrix() * side_a.body_point;
   const Eigen::Vector3d x2 = b.r + b.attitude.matrix() * side_b.body_point;
-  Matrix3x14 dx1 = fixed_point_jacobian(a, side_a, 0);
-  Matrix3x14 dx2 = fixed_point_jacobian(b, side_b, 7);
-  add_point_motion(a, side_a, b, side_b, x1 - x2, dx1, dx2);
+  const PointMotion motion = core_point_motion(a, side_a, b, side_b);
 
   Matrix3x14 dnormal = Matrix3x14::Zero();
   switch (solution.source.kind) {
     case NormalSource::Kind::kClosestPoints:
-      dnormal = unit_vector_motion(x2 - x1, dx2 - dx1);
+      dnormal = unit_vector_motion(x2 - x1, motion.dp2 - motion.dp1);
       break;
     case NormalSource::Kind::kFace: {
       const PosedCore& face = solution.source.face_core == 0 ? a : b;
@@ -77,14 +75,8 @@ SignedDistanceJacobian make_signed_distance_jacobian(const PairFrame& frame, con
     case NormalSource::Kind::kFixed:
       break;
   }
-  result.core_points_jacobian.topRows<3>() = dx1;
-  result.core_points_jacobian.bottomRows<3>() = dx2;
-  result.points_jacobian.topRows<3>() = dx1 + a.radius * dnormal;
-  result.points_jacobian.bottomRows<3>() = dx2 - b.radius * dnormal;
-  for (const int column : {3, 10}) {  // d/dq of a length: the quaternion columns scale
-    result.core_points_jacobian.middleCols<4>(column) *= frame.scale;
-    result.points_jacobian.middleCols<4>(column) *= frame.scale;
-  }
+  point_jacobians(frame.scale, a, b, motion, dnormal, result.core_points_jacobian,
+                  result.points_jacobian);
   return result;
 }
 
