@@ -9,6 +9,7 @@
 #include <random>
 
 #include "diffpills/diffpills.hpp"
+#include "proximity/pair_frame.hpp"
 #include "proximity/polygon_windows.hpp"
 #include "proximity/separated_polygons.hpp"
 #include "support/random_shapes.hpp"
@@ -62,13 +63,18 @@ BothPaths both_paths(const PaddedPolygon& a, const Pose& pa, const PaddedPolygon
                 {},
                 {pa.r(), detail::UnitQuaternion(pa.q()), 0.0, a.extent()},
                 {pb.r(), detail::UnitQuaternion(pb.q()), 0.0, b.extent()}};
-  const double tolerance = 1e-12 * std::max({a.extent(), b.extent(), (pb.r() - pa.r()).norm()});
+  const detail::PairFrame scales =
+      detail::make_pair_frame(a.extent(), 0.0, b.extent(), 0.0, pa.r(), pb.r());
+  const double tolerance = scales.tolerance * scales.scale;
+  const double tie_tolerance = scales.tie_tolerance * scales.scale;
   const detail::PolygonPairFrame frame(out.a, out.b);
   const detail::CarriedPolygon<detail::PolygonView> W(view_b, frame.b_in_a, frame.b_origin_in_a);
   const detail::CarriedPolygon<detail::PolygonView> X(view_a, frame.b_in_a.transpose(),
                                                       frame.a_origin_in_b);
-  out.windows = detail::closest_separated_by_windows(view_a, view_b, frame, W, tolerance);
-  out.enumeration = detail::closest_separated(view_a, view_b, frame, W, X, tolerance);
+  out.windows =
+      detail::closest_separated_by_windows(view_a, view_b, frame, W, tolerance, tie_tolerance);
+  out.enumeration =
+      detail::closest_separated(view_a, view_b, frame, W, X, tolerance, tie_tolerance);
   return out;
 }
 
@@ -120,7 +126,7 @@ TEST(LargePolygons, NearlyParallelFacesAgreeWithEnumerationAndBruteForce) {
   int compared = 0;
   for (const double tilt : {1e-11, -1e-10, 1e-9, 1e-7}) {
     for (const int axis : {0, 1}) {
-      for (const Eigen::Vector3d offset :
+      for (const Eigen::Vector3d& offset :
            {Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d(1.5, 0, 0.5),
             Eigen::Vector3d(1.999, 0, 1e-6), Eigen::Vector3d(0, 0, 1e-9)}) {
         Eigen::Vector4d q(std::cos(tilt / 2), 0, 0, 0);
@@ -131,7 +137,7 @@ TEST(LargePolygons, NearlyParallelFacesAgreeWithEnumerationAndBruteForce) {
         const BothPaths paths = both_paths(disc, pa, disc, pb);
         const Eigen::Vector3d w1 = world(paths.a, paths.windows[0]);
         const Eigen::Vector3d w2 = world(paths.b, paths.windows[1]);
-        // The windows' certificates hold to a few times the tie tolerance (1e-12 of the scene):
+        // The windows' certificates hold to a few times the tolerance (1e-12 of the scene):
         // at a tilt of 1e-11 a face is level to within the certificate's slack over the whole
         // window.
         const double enumerated =
@@ -269,6 +275,77 @@ TEST(LargePolygons, PolygonsFarSmallerThanTheirDistance) {
     EXPECT_EQ(apart.core_points[1], pb.r());
     EXPECT_DOUBLE_EQ(apart.phi, (pa.r() - pb.r()).squaredNorm() - 0.0625);
     EXPECT_FALSE(apart.cores_intersect);
+  }
+}
+
+// A regular polygon whose rows are the unit normals at angles 2 pi k / count and offsets the
+// apothem; its vertices computed here, at the angles (2k + 1) pi / count between the rows.
+TestShape regular_polygon(int count, double apothem) {
+  Eigen::MatrixX2d C(count, 2);
+  std::vector<Eigen::Vector3d> body;
+  const double circumradius = apothem / std::cos(M_PI / count);
+  for (int k = 0; k < count; ++k) {
+    C.row(k) << std::cos(2 * M_PI * k / count), std::sin(2 * M_PI * k / count);
+    const double between = (2 * k + 1) * M_PI / count;
+    body.emplace_back(circumradius * std::cos(between), circumradius * std::sin(between), 0.0);
+  }
+  return {PaddedPolygon(C, Eigen::VectorXd::Constant(count, apothem), 0.0), body, circumradius};
+}
+
+// Shapes far apart compared to their size, parallel, one to the side of the other's shadow: the
+// far side of a polygon is farther than the near side by only (H^2 - h^2) / 2V for a distance V
+// and horizontal offsets h < H. Ties judged by 1e-12 of the scene's size (which includes V) let an
+// edge of the far side, parallel to the other's, win over the near side's vertex: points 1e-6 of
+// the scene off, and phi 1e-12 relative, different in the two orders (found by fuzz_proximity at
+// V = 2.9e76, polygons of 3 and 1e70). Both orders must give the brute force's points to 1e-9 of
+// the scene, for the windows (51-gons) and the enumeration (hexagons), and for a capsule, up to
+// V = 1e5 times the shapes' size. (Beyond ~1e6, neighbouring candidates' distances differ by less
+// than the tie tolerance's 64 ulps of the scene: the points are then as good as the distances.)
+TEST(LargePolygons, FarApartShapesKeepTheirNearSides) {
+  const Eigen::Vector4d flipped(0, 0, 1, 0);  // half a turn about y: the other face up
+  const auto expect_near_side = [](const TestShape& a, const Pose& pa, const TestShape& b,
+                                   const Pose& pb, double scene) {
+    const ClosestPair reference = brute_force_closest(to_world(a, pa), to_world(b, pb));
+    const Eigen::Vector3d p1 = reference.p1.cast<double>(), p2 = reference.p2.cast<double>();
+    const Proximity ab = std::visit(
+        [&](const auto& x, const auto& y) { return proximity(x, pa, y, pb); }, a.shape, b.shape);
+    const Proximity ba = std::visit(
+        [&](const auto& x, const auto& y) { return proximity(x, pb, y, pa); }, b.shape, a.shape);
+    EXPECT_LE((ab.core_points[0] - p1).norm(), 1e-9 * scene) << ab.core_points[0].transpose();
+    EXPECT_LE((ab.core_points[1] - p2).norm(), 1e-9 * scene) << ab.core_points[1].transpose();
+    EXPECT_LE((ba.core_points[1] - p1).norm(), 1e-9 * scene) << ba.core_points[1].transpose();
+    EXPECT_LE((ba.core_points[0] - p2).norm(), 1e-9 * scene) << ba.core_points[0].transpose();
+    EXPECT_NEAR(ab.phi, ba.phi, 1e-14 * scene * scene);
+  };
+
+  // The fuzz input: a 51-gon of apothem 3 far below one of apothem 1e70, beside its shadow.
+  const TestShape speck = regular_polygon(51, 3.0), plate = regular_polygon(51, 1.0352619520185846e70);
+  expect_near_side(speck, Pose(Eigen::Vector3d(2.0705239040371691e70, 0, -2.877773982520949e76),
+                               kIdentity),
+                   plate, Pose(Eigen::Vector3d::Zero(), flipped), 2.877773982520949e76);
+
+  // A polygon and the same polygon face down, far above, beside its shadow on the ray through a
+  // vertex of the first, with a vertex pointing back at it: the nearest pair is those two vertices
+  // (unique), and every edge has a parallel partner on the far side. A capsule on the same ray,
+  // pointing at the vertex.
+  for (const int count : {6, 51}) {
+    for (const double small : {1e-3, 1.0}) {
+      for (const double height : {1e2, 1e3, 1e4, 1e5}) {
+        SCOPED_TRACE(::testing::Message() << count << "-gons, " << small << ", V = " << height);
+        const TestShape a = regular_polygon(count, 1.0), b = regular_polygon(count, small);
+        const Eigen::Vector3d ray(std::cos(M_PI / count), std::sin(M_PI / count), 0.0);
+        const Eigen::Vector3d up(0, 0, height);
+        const Pose pa(Eigen::Vector3d::Zero(), kIdentity);
+        expect_near_side(a, pa, b, Pose((a.size + b.size + 0.5) * ray + up, flipped), height);
+        const TestShape capsule{Capsule(small, 0.1),
+                                {Eigen::Vector3d(-0.5 * small, 0, 0),
+                                 Eigen::Vector3d(0.5 * small, 0, 0)},
+                                small};
+        expect_near_side(a, pa, capsule,
+                         Pose((a.size + small + 0.5) * ray + up, about(M_PI / count, 0, 0, 1)),
+                         height);
+      }
+    }
   }
 }
 

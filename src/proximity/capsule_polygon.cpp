@@ -18,13 +18,14 @@ namespace diffpills::detail {
 //     in the plane);
 //   - the segment parallel to an edge and beside it: the overlap of the two, which the edge's
 //     segment-segment solution reports (SegmentParameters::overlap). Its distance ties with the
-//     neighbouring edges' at the shared vertex; the overlap wins ties within the tolerance.
+//     neighbouring edges' at the shared vertex; the overlap wins ties within the tie tolerance
+//     that include the best point.
 // Both are found with the polygon grown by the tolerance, so that a segment touching the boundary
 // is not decided by rounding.
 std::array<ClosestFeature, 2> solve_capsule_polygon(const PosedCore& capsule,
                                                     const PolygonView& polygon,
                                                     const PosedCore& posed_polygon,
-                                                    double tolerance) {
+                                                    double tolerance, double tie_tolerance) {
   const double length = capsule.size;
   const Eigen::Matrix3d& R = posed_polygon.attitude.matrix();
   const Eigen::Vector3d axis = capsule.attitude.matrix().col(0);
@@ -51,6 +52,7 @@ std::array<ClosestFeature, 2> solve_capsule_polygon(const PosedCore& capsule,
   struct Candidate {
     double distance2 = std::numeric_limits<double>::infinity();
     std::array<ClosestFeature, 2> sides;
+    double half_width = 0.0;  // an overlap's: half its length (the same on the segment and edge)
   } best, best_overlap;
   for (const double s : {0.0, 1.0}) {
     const Eigen::Vector3d end = p + s * length * u;
@@ -66,11 +68,22 @@ std::array<ClosestFeature, 2> solve_capsule_polygon(const PosedCore& capsule,
             .squaredNorm();
     Candidate& kept = closest.overlap ? best_overlap : best;
     if (distance2 < kept.distance2) {
-      kept = {distance2, {segment_point(length, closest.s), edge_point(polygon, j, closest.t)}};
+      kept = {distance2,
+              {segment_point(length, closest.s), edge_point(polygon, j, closest.t)},
+              closest.half_overlap * length};
     }
   }
-  const double reach = std::sqrt(best.distance2) + tolerance;
-  return best_overlap.distance2 <= reach * reach ? best_overlap.sides : best.sides;
+  // The overlap wins if it is as close, and a tie within the tie tolerance if the best pair lies
+  // on it (as in separated_polygons.cpp's Best::choice): a tie in distance alone may be another
+  // edge's overlap when the shapes are far apart compared to their size.
+  if (best_overlap.distance2 <= best.distance2) return best_overlap.sides;
+  const double reach = std::sqrt(best.distance2) + tie_tolerance;
+  if (best_overlap.distance2 > reach * reach) return best.sides;
+  const double reach_of_overlap = best_overlap.half_width + tolerance;
+  const bool on_overlap =
+      (best.sides[0].body_point - best_overlap.sides[0].body_point).norm() <= reach_of_overlap &&
+      (best.sides[1].body_point - best_overlap.sides[1].body_point).norm() <= reach_of_overlap;
+  return on_overlap ? best_overlap.sides : best.sides;
 }
 
 }  // namespace diffpills::detail

@@ -17,9 +17,19 @@ namespace diffpills::detail {
 struct PairFrame {
   double scale = 1.0;          // a length in the frame times scale is a length of the inputs
   double inverse_scale = 1.0;  // 1 / scale, exact (also a power of two)
-  // Two distances (or heights) closer than this are taken as equal: the relative tie and
-  // intersection tolerance, 1e-12 of the scene's size, in the frame's units.
+  // Two cores closer than this intersect, and a point closer than this to a polygon's boundary
+  // is on it: the relative intersection tolerance, 1e-12 of the scene's size, in the frame's
+  // units.
   double tolerance = 0.0;
+  // Two candidates for the closest pair whose distances differ by less than this tie (and a
+  // candidate standing for a whole interval wins, fast_paths.hpp): 2e-12 of the larger core's
+  // size (the most by which the height of a feature counted as parallel, |sin| <= 1e-12, can
+  // vary) plus 64 ulps of the scene's size (the rounding of coordinates as far out as the scene
+  // reaches). Not 1e-12 of the scene's size: a scene's size includes the distance between the
+  // shapes, and for two shapes a distance V apart, candidates h and H to the side of each other
+  // differ in distance only by (H^2 - h^2) / 2V, so that ties judged by the scene's size took a
+  // vertex of the far side of a polygon 1e-6 of the scene away (found by fuzz_proximity).
+  double tie_tolerance = 0.0;
 };
 
 // size_* is a core's length scale (a capsule's length, a polygon's extent), radius_* its padding.

@@ -84,10 +84,10 @@ bool plane_section(const CarriedPolygon<PolygonView>& W, const Eigen::Vector3d& 
 //     parallel to the other's plane, the middle of its part over the face;
 //   - an edge of each (segment_segment.hpp), the middle of their overlap when parallel;
 // found by enumeration (separated_polygons.hpp) or, for many vertices, in windows
-// (polygon_windows.hpp). Candidates for a whole interval win ties within the tolerance.
+// (polygon_windows.hpp). Candidates for a whole interval win ties within the tie tolerance.
 std::array<ClosestFeature, 2> solve_polygon_polygon(const PolygonView& a, const PosedCore& posed_a,
                                                     const PolygonView& b, const PosedCore& posed_b,
-                                                    double tolerance) {
+                                                    double tolerance, double tie_tolerance) {
   const PolygonPairFrame frame(posed_a, posed_b);
   const CarriedPolygon<PolygonView> W(b, frame.b_in_a, frame.b_origin_in_a);
   const Eigen::Vector3d b_normal = frame.b_in_a.col(2);
@@ -108,10 +108,10 @@ std::array<ClosestFeature, 2> solve_polygon_polygon(const PolygonView& a, const 
     }
   }
   if (a.size() * b.size() > kEnumerationLimit) {
-    return closest_separated_by_windows(a, b, frame, W, tolerance);
+    return closest_separated_by_windows(a, b, frame, W, tolerance, tie_tolerance);
   }
   const CarriedPolygon<PolygonView> X(a, frame.b_in_a.transpose(), frame.a_origin_in_b);
-  return closest_separated(a, b, frame, W, X, tolerance);
+  return closest_separated(a, b, frame, W, X, tolerance, tie_tolerance);
 }
 
 }  // namespace diffpills::detail

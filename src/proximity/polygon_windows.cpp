@@ -97,7 +97,9 @@ bool add_arc(Window& window, const Arc& arc, Eigen::Index size) {
 // 2 slack of the support planes are added: they hold every closest point and every tie of a
 // certified pair, and the violators of an uncertified one. The windows only grow, so the loop
 // ends; it ends when nothing is added, with a certified pair whose ties are all in the windows.
-// slack = tolerance |d|: ties and certificates share the frame's tolerance.
+// slack = max(tolerance, tie_tolerance) |d|: the frame's intersection tolerance, or its tie
+// tolerance (pair_frame.hpp) if larger, by which the sub-problems judge ties, so that every tie
+// is in the windows.
 //
 // Supports are found by climbing from the previous ones along the boundary, so that an iteration
 // costs the windows' enumeration plus the support's movement, not the polygons' size; each
@@ -108,7 +110,8 @@ std::array<ClosestFeature, 2> closest_separated_by_windows(const PolygonView& a,
                                                            const PolygonView& b,
                                                            const PolygonPairFrame& frame,
                                                            const CarriedPolygon<PolygonView>& W,
-                                                           double tolerance) {
+                                                           double tolerance,
+                                                           double tie_tolerance) {
   Window window_a(a.size()), window_b(b.size());
   // First guess: the supports along the line between the body origins (each inside its polygon).
   Eigen::Vector3d d = frame.b_origin_in_a;
@@ -124,9 +127,9 @@ std::array<ClosestFeature, 2> closest_separated_by_windows(const PolygonView& a,
     const CarriedPolygon<SubPolygon> sub_W(sub_b, frame.b_in_a, frame.b_origin_in_a);
     const CarriedPolygon<SubPolygon> sub_X(sub_a, frame.b_in_a.transpose(), frame.a_origin_in_b);
     std::array<ClosestFeature, 2> sides =
-        closest_separated(sub_a, sub_b, frame, sub_W, sub_X, tolerance);
+        closest_separated(sub_a, sub_b, frame, sub_W, sub_X, tolerance, tie_tolerance);
     d = frame.b_in_a * sides[1].body_point + frame.b_origin_in_a - sides[0].body_point;
-    const double margin = 2.0 * tolerance * d.norm();
+    const double margin = 2.0 * std::max(tolerance, tie_tolerance) * d.norm();
     top_a = climb(top_a, a.size(), along_a);
     bottom_b = climb(bottom_b, b.size(), against_b);
     // A polygon whose extent is within the margin (a speck, far smaller than the scene) is taken
@@ -143,11 +146,15 @@ std::array<ClosestFeature, 2> closest_separated_by_windows(const PolygonView& a,
     bool grew_b = arc_b.whole ? window_b.add(bottom_b) : add_arc(window_b, arc_b, b.size());
     std::array<ClosestFeature, 2> over_face;
     if (arc_a.whole && !arc_b.whole && !grew_b) {
-      if (closest_over_face(a, sub_b, sub_W, true, tolerance, over_face)) return over_face;
+      if (closest_over_face(a, sub_b, sub_W, true, tolerance, tie_tolerance, over_face)) {
+        return over_face;
+      }
       grew_a = add_arc(window_a, arc_a, a.size());  // the support over A's boundary: its edges
     }
     if (arc_b.whole && !arc_a.whole && !grew_a) {
-      if (closest_over_face(b, sub_a, sub_X, false, tolerance, over_face)) return over_face;
+      if (closest_over_face(b, sub_a, sub_X, false, tolerance, tie_tolerance, over_face)) {
+        return over_face;
+      }
       grew_b = add_arc(window_b, arc_b, b.size());
     }
     if (!grew_a && !grew_b) return sides;

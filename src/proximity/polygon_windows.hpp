@@ -15,6 +15,7 @@ std::array<ClosestFeature, 2> closest_separated_by_windows(const PolygonView& a,
                                                            const PolygonView& b,
                                                            const PolygonPairFrame& frame,
                                                            const CarriedPolygon<PolygonView>& W,
-                                                           double tolerance);
+                                                           double tolerance,
+                                                           double tie_tolerance);
 
 }  // namespace diffpills::detail

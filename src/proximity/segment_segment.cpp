@@ -99,6 +99,7 @@ SegmentParameters closest_segment_parameters(const Segment& P, const Segment& Q)
       s = 0.5 * (low + high);
       t = best_t(s);
       out.overlap = low < high;
+      out.half_overlap = 0.5 * (high - low) / a;
     } else {
       s = clamp(0.5 * (s0 + s1), a);
       t = best_t(s);

@@ -21,6 +21,8 @@ struct SegmentParameters {
   // The segments are parallel and overlap along an interval of positive length, of which (s, t)
   // is the middle: the closest points are not unique.
   bool overlap = false;
+  double half_overlap = 0.0;  // half the overlap's length, as a fraction of P's length
+
 };
 
 // argmin over s, t in [0, 1] of |P(s) - Q(t)|^2 (paper eq. capsule_opt). A zero-length segment

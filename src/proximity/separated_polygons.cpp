@@ -48,6 +48,8 @@ struct Candidate {
   Kind kind = Kind::kEdges;
   Eigen::Index i = 0, j = 0;  // A's and B's feature
   double s = 1.0, t = 1.0;    // edge parameters
+  // An interval's half lengths on A's side and on B's (in A's and B's body frames).
+  double half_width_a = 0.0, half_width_b = 0.0;
 };
 
 // The best candidate and, apart, the best one standing for a whole interval of closest points.
@@ -57,10 +59,21 @@ struct Best {
     Candidate& kept = is_interval ? interval : point;
     if (candidate.distance2 < kept.distance2) kept = candidate;
   }
-  // The interval wins a tie within the tolerance (see fast_paths.hpp).
-  const Candidate& choice(double tolerance) const {
-    const double reach = std::sqrt(point.distance2) + tolerance;
-    return interval.distance2 <= reach * reach ? interval : point;
+  // The interval wins if it is as close as the point, and a tie within the tie tolerance (see
+  // fast_paths.hpp) if the point's pair is one of the interval's: each of its two points within
+  // the half width (plus the intersection tolerance) of the interval's middle on that side. A tie
+  // in distance alone does not tell the same optimal set from another feature at almost the same
+  // distance, which happens where the shapes are far apart compared to their size
+  // (pair_frame.hpp). sides_of(candidate): its two sides, each in its body frame.
+  template <class SidesOf>
+  const Candidate& choice(double tolerance, double tie_tolerance, const SidesOf& sides_of) const {
+    if (interval.distance2 <= point.distance2) return interval;
+    const double reach = std::sqrt(point.distance2) + tie_tolerance;
+    if (interval.distance2 > reach * reach) return point;
+    const std::array<ClosestFeature, 2> p = sides_of(point), i = sides_of(interval);
+    const bool on_a = (p[0].body_point - i[0].body_point).norm() <= interval.half_width_a + tolerance;
+    const bool on_b = (p[1].body_point - i[1].body_point).norm() <= interval.half_width_b + tolerance;
+    return on_a && on_b ? interval : point;
   }
 };
 
@@ -87,15 +100,17 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
     return;  // the polygon meets the plane: no point over the face can be closest
   }
   const auto candidate = [&](Kind b_kind, Kind a_kind, Eigen::Index feature, double parameter,
-                             double height) {
-    Candidate c{height * height, polygon_is_b ? b_kind : a_kind, 0, 0, parameter, parameter};
+                             double height, double half_width, double half_shadow) {
+    Candidate c{height * height, polygon_is_b ? b_kind : a_kind, 0, 0, parameter, parameter,
+                polygon_is_b ? half_shadow : half_width, polygon_is_b ? half_width : half_shadow};
     (polygon_is_b ? c.j : c.i) = feature;
     return c;
   };
   const Eigen::Vector3d& vertex = polygon[support];
   if (contains(over, vertex.head<2>(), 0.0)) {
-    best.offer(candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z()),
-               false);
+    best.offer(
+        candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z(), 0.0, 0.0),
+        false);
   }
   const Eigen::Index following = support + 1 == polygon.size() ? 0 : support + 1;
   for (const Eigen::Index j : {support, following}) {  // the two edges at the support vertex
@@ -106,7 +121,11 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
     if (low <= high) {
       const double middle = 0.5 * (low + high);
       const double height = start.z() + middle * (end.z() - start.z());
-      best.offer(candidate(Kind::kBEdgeOverA, Kind::kAEdgeOverB, j, middle, height), true);
+      // The interval: a part of the polygon's edge, and its shadow on the face.
+      const double half = 0.5 * (high - low);
+      best.offer(candidate(Kind::kBEdgeOverA, Kind::kAEdgeOverB, j, middle, height,
+                           half * (end - start).norm(), half * (end - start).head<2>().norm()),
+                 true);
     }
   }
 }
@@ -165,7 +184,10 @@ void offer_edge_pair(const Segment& edge, const EdgeBound& a_bound, Eigen::Index
   const double distance2 = (edge.start + (closest.s * edge.length) * edge.direction - other.start -
                             (closest.t * other.length) * other.direction)
                                .squaredNorm();
-  best.offer({distance2, Kind::kEdges, i, j, closest.s, closest.t}, closest.overlap);
+  // Parallel edges overlap along intervals of the same length on both.
+  const double half_width = closest.half_overlap * edge.length;
+  best.offer({distance2, Kind::kEdges, i, j, closest.s, closest.t, half_width, half_width},
+             closest.overlap);
   reach = std::sqrt(best.point.distance2) + tolerance;
 }
 
@@ -295,7 +317,8 @@ template <class Polygon>
 std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
                                         const PolygonPairFrame& frame,
                                         const CarriedPolygon<Polygon>& W,
-                                        const CarriedPolygon<Polygon>& X, double tolerance) {
+                                        const CarriedPolygon<Polygon>& X, double tolerance,
+                                        double tie_tolerance) {
   const Eigen::Index kb = b.size();
   Best best;
   offer_over_face(W, a, true, tolerance, best);
@@ -315,7 +338,8 @@ std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
   } else {
     visit_all_pairs(a, W, b_edges, b_bounds, tolerance, best);
   }
-  return sides(best.choice(tolerance), a, b, W, X);
+  const auto sides_of = [&](const Candidate& c) { return sides(c, a, b, W, X); };
+  return sides(best.choice(tolerance, tie_tolerance, sides_of), a, b, W, X);
 }
 
 }  // namespace
@@ -324,24 +348,27 @@ std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const Poly
                                                 const PolygonPairFrame& frame,
                                                 const CarriedPolygon<PolygonView>& W,
                                                 const CarriedPolygon<PolygonView>& X,
-                                                double tolerance) {
-  return enumerate(a, b, frame, W, X, tolerance);
+                                                double tolerance, double tie_tolerance) {
+  return enumerate(a, b, frame, W, X, tolerance, tie_tolerance);
 }
 
 std::array<ClosestFeature, 2> closest_separated(const SubPolygon& a, const SubPolygon& b,
                                                 const PolygonPairFrame& frame,
                                                 const CarriedPolygon<SubPolygon>& W,
                                                 const CarriedPolygon<SubPolygon>& X,
-                                                double tolerance) {
-  return enumerate(a, b, frame, W, X, tolerance);
+                                                double tolerance, double tie_tolerance) {
+  return enumerate(a, b, frame, W, X, tolerance, tie_tolerance);
 }
 
 bool closest_over_face(const PolygonView& face, const SubPolygon& other,
                        const CarriedPolygon<SubPolygon>& carried, bool face_is_a, double tolerance,
-                       std::array<ClosestFeature, 2>& out) {
+                       double tie_tolerance, std::array<ClosestFeature, 2>& out) {
   Best best;
   offer_over_face(carried, face, face_is_a, tolerance, best);
-  const Candidate& chosen = best.choice(tolerance);
+  const auto sides_of = [&](const Candidate& c) {
+    return over_face_sides(c, other, carried, face_is_a);
+  };
+  const Candidate& chosen = best.choice(tolerance, tie_tolerance, sides_of);
   if (chosen.distance2 == std::numeric_limits<double>::infinity()) return false;
   out = over_face_sides(chosen, other, carried, face_is_a);
   return true;

@@ -53,17 +53,17 @@ class CarriedPolygon {
 // polygon_polygon.cpp): a support vertex of one over the other's face (or, for an edge parallel to
 // that face, the middle of its part over it), and every pair of edges (the middle of their overlap
 // when parallel), the pairs whose lower bound exceeds the best distance by the tolerance skipped.
-// Candidates for a whole interval win ties within the tolerance.
+// Candidates for a whole interval win ties within the tie tolerance (pair_frame.hpp).
 std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const PolygonView& b,
                                                 const PolygonPairFrame& frame,
                                                 const CarriedPolygon<PolygonView>& W,
                                                 const CarriedPolygon<PolygonView>& X,
-                                                double tolerance);
+                                                double tolerance, double tie_tolerance);
 std::array<ClosestFeature, 2> closest_separated(const SubPolygon& a, const SubPolygon& b,
                                                 const PolygonPairFrame& frame,
                                                 const CarriedPolygon<SubPolygon>& W,
                                                 const CarriedPolygon<SubPolygon>& X,
-                                                double tolerance);
+                                                double tolerance, double tie_tolerance);
 
 // When the face of one polygon is its whole support face (the closest points' difference is along
 // its normal), the closest pairs are the other's support vertex over that face, or the middle of
@@ -72,6 +72,6 @@ std::array<ClosestFeature, 2> closest_separated(const SubPolygon& a, const SubPo
 // a's. Returns false if no such candidate lies over the face (the pair is then on its boundary).
 bool closest_over_face(const PolygonView& face, const SubPolygon& other,
                        const CarriedPolygon<SubPolygon>& carried, bool face_is_a, double tolerance,
-                       std::array<ClosestFeature, 2>& out);
+                       double tie_tolerance, std::array<ClosestFeature, 2>& out);
 
 }  // namespace diffpills::detail
