@@ -30,6 +30,11 @@
 //   - Parallelism thresholds are relative, so they mean the same at every scale: |sin| <= 1e-12
 //     between a segment and a segment, a plane or another plane (where the distance varies
 //     linearly with a tilt, so the middle of the optimal set stays within 1e-12 of optimal).
+//     The optimal set is found from the candidates that tie: distances within 2e-12 of the larger
+//     core's size plus 64 ulps of the scene's size, and the point candidate on the interval.
+//     Shapes far apart compared to their size (a distance V, sizes h) have their closest points
+//     to within the scene's rounding only: beyond V ~ 1e6 h neighbouring candidates' distances
+//     differ by less than the tie tolerance.
 //   - Zero length capsules are spheres.
 //   - Intersecting cores (|p1 - p2| <= 1e-12 of the scene's size): cores_intersect is true,
 //     phi = -(R1 + R2)^2 and its gradient vanishes up to rounding (the proximity is flat there:
@@ -41,7 +46,8 @@
 //     kMaxMagnitude, polygons with offsets d_i / |C_i| as small as 1e-300) is answered to full
 //     accuracy relative to the pair's scene: each pair is solved in a frame whose unit is a power
 //     of two near the scene's size (the largest of the cores' sizes, the radii and the distance
-//     between the body origins), and lengths come out with errors of about 1e-16 of that size. A
+//     between the body origins), and lengths come out with errors of about 1e-16 of that size
+//     (polygons of more than 32 x 32 vertex pairs, solved in windows: a few 1e-12 of it). A
 //     gap far smaller than the scene is resolved only to that absolute error: a point 1 from the
 //     middle of a 1e20-long capsule gets phi to about (1e-16 * 1e20)^2, and two specks 1e-300
 //     apart beside a unit capsule get phi = 0. Scaling every length by 2^k scales phi by exactly

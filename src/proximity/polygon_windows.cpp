@@ -1,6 +1,7 @@
 #include "polygon_windows.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <vector>
 
 namespace diffpills::detail {
@@ -101,6 +102,15 @@ bool add_arc(Window& window, const Arc& arc, Eigen::Index size) {
 // tolerance (pair_frame.hpp) if larger, by which the sub-problems judge ties, so that every tie
 // is in the windows.
 //
+// d's rounding. p1 and p2 carry errors of a few ulps of their own size, so d is off by up to
+// delta = 64 eps (|p1| + |p2|), and a polygon's values x . d by up to 2 extent delta: for a gap far
+// below the polygons' size that is far above the slack, and the supports, the window's own
+// included, are then decided by rounding (two unit 600-gons 1e-9 apart, 1e-10 rad from parallel,
+// came out 9.43e-10 apart instead of 9.00e-10: the windows held B's vertex the rounding chose, not
+// its lowest). Each polygon's margin therefore adds 2 extent delta. Where that takes in both
+// polygons whole (faces facing each other closer than rounding can tell directions apart), both
+// windows become the whole polygons and the enumeration (its sweep) decides.
+//
 // Supports are found by climbing from the previous ones along the boundary, so that an iteration
 // costs the windows' enumeration plus the support's movement, not the polygons' size; each
 // iteration sorts the window's members. Measured: ~10 to 20 iterations for
@@ -128,22 +138,31 @@ std::array<ClosestFeature, 2> closest_separated_by_windows(const PolygonView& a,
     const CarriedPolygon<SubPolygon> sub_X(sub_a, frame.b_in_a.transpose(), frame.a_origin_in_b);
     std::array<ClosestFeature, 2> sides =
         closest_separated(sub_a, sub_b, frame, sub_W, sub_X, tolerance, tie_tolerance);
-    d = frame.b_in_a * sides[1].body_point + frame.b_origin_in_a - sides[0].body_point;
-    const double margin = 2.0 * std::max(tolerance, tie_tolerance) * d.norm();
+    const Eigen::Vector3d p1 = sides[0].body_point;
+    const Eigen::Vector3d p2 = frame.b_in_a * sides[1].body_point + frame.b_origin_in_a;
+    d = p2 - p1;
+    const double slack = std::max(tolerance, tie_tolerance) * d.norm();
+    const double rounding = 64 * std::numeric_limits<double>::epsilon() * (p1.norm() + p2.norm());
+    const double margin_a = 2.0 * (slack + 2.0 * a.extent() * rounding);
+    const double margin_b = 2.0 * (slack + 2.0 * b.extent() * rounding);
     top_a = climb(top_a, a.size(), along_a);
     bottom_b = climb(bottom_b, b.size(), against_b);
     // A polygon whose extent is within the margin (a speck, far smaller than the scene) is taken
     // whole: a window of it would have chords between vertices that its few resolved digits, or
     // underflow, can make coincide, and a chord of no length bounds nothing.
-    const Arc arc_a = a.extent() <= margin ? Arc{0, a.size(), false}
-                                           : arc_around(top_a, a.size(), margin, along_a);
-    const Arc arc_b = b.extent() <= margin ? Arc{0, b.size(), false}
-                                           : arc_around(bottom_b, b.size(), margin, against_b);
+    const Arc arc_a = a.extent() <= margin_a ? Arc{0, a.size(), false}
+                                             : arc_around(top_a, a.size(), margin_a, along_a);
+    const Arc arc_b = b.extent() <= margin_b ? Arc{0, b.size(), false}
+                                             : arc_around(bottom_b, b.size(), margin_b, against_b);
     // A whole polygon within the margin is a face facing the other along its normal: its windows
     // keep only the support (enough for the certificate), and once the other side's arc is in
-    // its window the answer is the other's support over that whole face.
-    bool grew_a = arc_a.whole ? window_a.add(top_a) : add_arc(window_a, arc_a, a.size());
-    bool grew_b = arc_b.whole ? window_b.add(bottom_b) : add_arc(window_b, arc_b, b.size());
+    // its window the answer is the other's support over that whole face. Both whole: both taken
+    // whole (see d's rounding above).
+    const bool both_whole = arc_a.whole && arc_b.whole;
+    bool grew_a = arc_a.whole && !both_whole ? window_a.add(top_a)
+                                             : add_arc(window_a, arc_a, a.size());
+    bool grew_b = arc_b.whole && !both_whole ? window_b.add(bottom_b)
+                                             : add_arc(window_b, arc_b, b.size());
     std::array<ClosestFeature, 2> over_face;
     if (arc_a.whole && !arc_b.whole && !grew_b) {
       if (closest_over_face(a, sub_b, sub_W, true, tolerance, tie_tolerance, over_face)) {
