@@ -252,6 +252,48 @@ TEST(Degenerate, ParallelBoundaryIsContinuousAtEveryScale) {
   }
 }
 
+// A long capsule (length L from 2^40 up to 2^66 ~ 7e19) with a small shape near its middle, at a
+// gap g = 2^-30 L (the cores intersect below 1e-12 L ~ 2^-40 L): the closest points are computed from the segments' middles, so the long capsule's
+// point keeps the digits of its own offset (0.3 here), and phi is g^2 to rounding. Anchored at the
+// ends, the offset was lost to the rounding of L / 2 (a hostile review: a stick 1e9 beside a
+// 1e20-long capsule got phi 1e18 + 1.2e8 and the point x = 11102 instead of 0.665). Analytic
+// answers, both orders.
+TEST(Degenerate, ShapesNearTheMiddleOfALongCapsule) {
+  Eigen::MatrixX2d C(3, 2);
+  C << 0, -1, 1, 1, -1, 1;
+  const PaddedPolygon triangle(C.rowwise().normalized(), Eigen::Vector3d(0.5, 0.5, 0.5), 0.0);
+  for (const int k : {40, 50, 66}) {
+    SCOPED_TRACE(k);
+    const double length = std::ldexp(1.0, k), gap = std::ldexp(1.0, k - 30);
+    const Capsule rod(length, 0.0), dot(0.0, 0.0), stick(2.0, 0.0);
+    const Pose along_x;
+    // A point at (0.3, g, 0): the rod's point (0.3, 0, 0), phi = g^2.
+    const Pose beside(Eigen::Vector3d(0.3, gap, 0.0), kIdentity);
+    // A stick of length 2 through (0.3, g, 0.25), turned 0.6 rad about y: its point nearest the x
+    // axis is at z = 0, s = 0.25 / sin 0.6 along it, and phi = g^2.
+    const Pose tilted(Eigen::Vector3d(0.3, gap, 0.25), about(0.6, 0, 1, 0));
+    const double stick_x = 0.3 + std::cos(0.6) * 0.25 / std::sin(0.6);
+    // The triangle's edge y = -1/2 parallel to the rod: phi = (g - 1/2)^2, the rod's point the
+    // middle of the edge's shadow, x = 0.3.
+    for (const bool swap : {false, true}) {
+      const auto query = [&](const auto& other, const Pose& pose) {
+        const Proximity r = swap ? proximity(other, pose, rod, along_x)
+                                 : proximity(rod, along_x, other, pose);
+        return std::make_pair(r.phi, r.core_points[swap ? 1 : 0]);
+      };
+      const auto [phi_dot, on_rod_dot] = query(dot, beside);
+      EXPECT_NEAR(phi_dot, gap * gap, 1e-14 * gap * gap);
+      EXPECT_NEAR(on_rod_dot.x(), 0.3, 1e-14 * gap);
+      const auto [phi_stick, on_rod_stick] = query(stick, tilted);
+      EXPECT_NEAR(phi_stick, gap * gap, 1e-14 * gap * gap);
+      EXPECT_NEAR(on_rod_stick.x(), stick_x, 1e-14 * gap);
+      const auto [phi_triangle, on_rod_triangle] = query(triangle, beside);
+      EXPECT_NEAR(phi_triangle, (gap - 0.5) * (gap - 0.5), 1e-14 * gap * gap);
+      EXPECT_NEAR(on_rod_triangle.x(), 0.3, 1e-14 * gap);
+    }
+  }
+}
+
 TEST(Degenerate, ExtremeScalesWithMixedSizes) {
   // A tiny capsule against a huge polygon, far from the origin, both orders.
   const Capsule tiny(1e-3, 1e-4);

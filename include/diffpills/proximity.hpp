@@ -48,12 +48,14 @@
 //     of two near the scene's size (the largest of the cores' sizes, the radii and the distance
 //     between the body origins), and lengths come out with errors of about 1e-16 of that size
 //     (polygons of more than 32 x 32 vertex pairs, solved in windows: a few 1e-12 of it). A
-//     gap far smaller than the scene is resolved only to that absolute error: a point 1 from the
-//     middle of a 1e20-long capsule gets phi to about (1e-16 * 1e20)^2, and two specks 1e-300
-//     apart beside a unit capsule get phi = 0. Scaling every length by 2^k scales phi by exactly
-//     2^(2k), the points by 2^k, the gradient's position part by 2^k and its quaternion part by
-//     2^(2k), bit for bit, while no length of the scene leaves the normal doubles (below ~1e-290
-//     squares underflow). The normal is unit to rounding at every scale.
+//     gap far smaller than the scene is resolved only to that absolute error (two specks 1e-300
+//     apart beside a unit capsule get phi = 0), and below 1e-12 of it the cores touch. Segments
+//     are solved from their middles, so a shape near the middle of a long capsule keeps its own
+//     digits: a stick 1e9 beside the middle of a 1e20-long capsule gets phi = 1e18 to rounding.
+//     Scaling every length by 2^k scales phi by exactly 2^(2k), the points by 2^k, the
+//     gradient's position part by 2^k and its quaternion part by 2^(2k), bit for bit, while no
+//     length of the scene leaves the normal doubles (below ~1e-290 squares underflow). The normal
+//     is unit to rounding at every scale.
 //
 // Errors: shapes and poses validate on construction (std::invalid_argument). The default method
 // never fails on valid shapes. The interior-point reference can: on badly scaled pairs (a core

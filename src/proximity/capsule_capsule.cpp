@@ -8,9 +8,9 @@ namespace diffpills::detail {
 std::array<ClosestFeature, 2> solve_capsule_capsule(const PosedCore& a, const PosedCore& b) {
   const Eigen::Vector3d axis_a = a.attitude.matrix().col(0);
   const Eigen::Vector3d axis_b = b.attitude.matrix().col(0);
-  const SegmentParameters closest = closest_segment_parameters(
-      {a.r - 0.5 * a.size * axis_a, axis_a, a.size}, {b.r - 0.5 * b.size * axis_b, axis_b, b.size});
-  return {segment_point(a.size, closest.s), segment_point(b.size, closest.t)};
+  const SegmentParameters closest =
+      closest_segment_parameters({a.r, axis_a, a.size}, {b.r, axis_b, b.size});
+  return {segment_point_at(a.size, closest.s_offset), segment_point_at(b.size, closest.t_offset)};
 }
 
 }  // namespace diffpills::detail

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -7,7 +8,7 @@
 namespace diffpills::detail {
 
 // In the polygon's body frame the core is {(y, 0) : y in polygon} and the segment is
-// x(s) = p + s L u, s in [0, 1], |u| = 1. The closest pair is one of
+// x(s) = m + s u, |s| <= L / 2, |u| = 1, m its middle. The closest pair is one of
 //   - a crossing of the plane z = 0 inside the polygon (distance zero, a single point unless the
 //     segment lies in the plane);
 //   - an end point over the face (distance |z|);
@@ -26,26 +27,29 @@ std::array<ClosestFeature, 2> solve_capsule_polygon(const PosedCore& capsule,
                                                     const PolygonView& polygon,
                                                     const PosedCore& posed_polygon,
                                                     double tolerance, double tie_tolerance) {
-  const double length = capsule.size;
+  const double length = capsule.size, half = 0.5 * capsule.size;
   const Eigen::Matrix3d& R = posed_polygon.attitude.matrix();
   const Eigen::Vector3d axis = capsule.attitude.matrix().col(0);
-  const Eigen::Vector3d p = R.transpose() * (capsule.r - 0.5 * length * axis - posed_polygon.r);
+  // The segment from its middle m (segment_segment.hpp: a point near the middle of a long capsule
+  // keeps the digits of its own offset), its start p only for clipping its line.
+  const Eigen::Vector3d m = R.transpose() * (capsule.r - posed_polygon.r);
   const Eigen::Vector3d u = R.transpose() * axis;
-  const Segment segment{p, u, length};
+  const Segment segment{m, u, length};
 
   if (length > 0.0 && std::abs(u.z()) <= 1e-12) {
+    const Eigen::Vector3d p = segment.at(-half);
     const auto [low, high] = clip_line(polygon, p.head<2>(), length * u.head<2>(), tolerance);
     if (low <= high) {
-      const double s = 0.5 * (low + high);
-      return {segment_point(length, s), face_point((p + s * length * u).head<2>())};
+      const double offset = (0.5 * (low + high) - 0.5) * length;
+      return {segment_point_at(length, offset), face_point(segment.at(offset).head<2>())};
     }
   }
-  const double z0 = p.z(), z1 = p.z() + length * u.z();
+  const double z0 = m.z() - half * u.z(), z1 = m.z() + half * u.z();
   if ((z0 < 0.0 && z1 > 0.0) || (z0 > 0.0 && z1 < 0.0)) {
-    const double s = z0 / (z0 - z1);
-    const Eigen::Vector2d crossing = (p + s * length * u).head<2>();
+    const double offset = std::clamp(-m.z() / u.z(), -half, half);
+    const Eigen::Vector2d crossing = segment.at(offset).head<2>();
     if (contains(polygon, crossing, tolerance)) {
-      return {segment_point(length, s), face_point(crossing)};
+      return {segment_point_at(length, offset), face_point(crossing)};
     }
   }
 
@@ -54,22 +58,21 @@ std::array<ClosestFeature, 2> solve_capsule_polygon(const PosedCore& capsule,
     std::array<ClosestFeature, 2> sides;
     double half_width = 0.0;  // an overlap's: half its length (the same on the segment and edge)
   } best, best_overlap;
-  for (const double s : {0.0, 1.0}) {
-    const Eigen::Vector3d end = p + s * length * u;
+  for (const double offset : {-half, half}) {
+    const Eigen::Vector3d end = segment.at(offset);
     if (end.z() * end.z() < best.distance2 && contains(polygon, end.head<2>(), 0.0)) {
-      best = {end.z() * end.z(), {segment_point(length, s), face_point(end.head<2>())}};
+      best = {end.z() * end.z(), {segment_point_at(length, offset), face_point(end.head<2>())}};
     }
   }
   for (Eigen::Index j = 0; j < polygon.size(); ++j) {
     const Segment edge = polygon.edge(j);
     const SegmentParameters closest = closest_segment_parameters(segment, edge);
     const double distance2 =
-        (p + (closest.s * length) * u - edge.start - (closest.t * edge.length) * edge.direction)
-            .squaredNorm();
+        (segment.at(closest.s_offset) - edge.at(closest.t_offset)).squaredNorm();
     Candidate& kept = closest.overlap ? best_overlap : best;
     if (distance2 < kept.distance2) {
       kept = {distance2,
-              {segment_point(length, closest.s), edge_point(polygon, j, closest.t)},
+              {segment_point_at(length, closest.s_offset), edge_point(polygon, j, closest.t)},
               closest.half_overlap * length};
     }
   }

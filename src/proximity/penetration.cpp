@@ -105,8 +105,9 @@ std::array<ClosestFeature, 2> edge_witnesses(const DeepestFacet& facet, const Co
                                              const CoreOutline& b) {
   const OutlineEdge& e = a.edge(facet.edges[0]);
   const OutlineEdge& f = b.edge(facet.edges[1]);
-  const SegmentParameters closest = closest_segment_parameters({e.start, e.direction, e.length},
-                                                               {f.start, f.direction, f.length});
+  const SegmentParameters closest =
+      closest_segment_parameters({e.start + 0.5 * e.length * e.direction, e.direction, e.length},
+                                 {f.start + 0.5 * f.length * f.direction, f.direction, f.length});
   return {a.edge_side(facet.edges[0], closest.s), b.edge_side(facet.edges[1], closest.t)};
 }
 

@@ -14,10 +14,10 @@ ClosestFeature face_point(const Eigen::Vector2d& y) {
   return side;
 }
 
-ClosestFeature segment_point(double length, double s) {
+ClosestFeature segment_point_at(double length, double offset) {
   ClosestFeature side;
-  side.body_point.x() = (s - 0.5) * length;
-  if (length > 0.0 && s > 0.0 && s < 1.0) {
+  side.body_point.x() = offset;
+  if (length > 0.0 && std::abs(offset) < 0.5 * length) {
     side.free_dimensions = 1;
     side.free_directions.col(0) = Eigen::Vector3d::UnitX();
   }

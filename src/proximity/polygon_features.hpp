@@ -29,10 +29,11 @@ class PolygonBoundary {
   }
   // Edge j as a segment of the body frame (z = 0), its length without a square root.
   Segment edge(Eigen::Index j) const {
-    const Eigen::Vector2d start = edge_start(j), direction = edge_direction(j);
-    return {{start.x(), start.y(), 0.0},
+    const Eigen::Vector2d start = edge_start(j), end = edge_end(j);
+    const Eigen::Vector2d middle = 0.5 * (start + end), direction = edge_direction(j);
+    return {{middle.x(), middle.y(), 0.0},
             {direction.x(), direction.y(), 0.0},
-            direction.dot(edge_end(j) - start)};
+            direction.dot(end - start)};
   }
 
  private:
@@ -112,8 +113,12 @@ ClosestFeature edge_point(const Polygon& polygon, Eigen::Index j, double t) {
   return side;
 }
 
-// The side of a capsule of `length` at parameter s (u = [(s - 1/2) L, 0, 0]): free along its
-// axis strictly inside, fixed at an end or for a sphere.
-ClosestFeature segment_point(double length, double s);
+// The side of a capsule of `length` at `offset` from its middle (u = [offset, 0, 0], |offset| <=
+// L / 2): free along its axis strictly inside, fixed at an end or for a sphere.
+ClosestFeature segment_point_at(double length, double offset);
+// The same at parameter s in [0, 1] (offset (s - 1/2) L).
+inline ClosestFeature segment_point(double length, double s) {
+  return segment_point_at(length, (s - 0.5) * length);
+}
 
 }  // namespace diffpills::detail

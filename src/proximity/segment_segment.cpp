@@ -5,15 +5,12 @@
 #include <array>
 
 namespace diffpills::detail {
-namespace {
 
-double clamp(double value, double high) { return std::clamp(value, 0.0, high); }
-
-}  // namespace
-
-// In length units: P(s) = p + s u, Q(t) = q + t v with unit u, v, s in [0, a], t in [0, b], and
-// w = p - q. The squared distance is |w + s u - t v|^2; with cos = u.v, c = u.w, f = v.w the best
-// t for a given s is f + s cos and the best s for a given t is t cos - c.
+// In length units, from the middles: P(s) = m + s u, Q(t) = n + t v with unit u, v,
+// s in [-h, h], t in [-k, k] (h, k the half lengths), and w = m - n. The squared distance is
+// |w + s u - t v|^2; with cos = u.v, c = u.w, f = v.w the best t for a given s is f + s cos and
+// the best s for a given t is t cos - c. Working from the middles keeps w, c and f of the size of
+// the segments' distance near their middles rather than of their half lengths.
 //
 // The stationary point (eq. capsule_opt without bounds). With n = u x v, |n| = sin of the angle,
 // crossing w + s u - t v = lambda n with v and dotting with n gives
@@ -31,7 +28,7 @@ double clamp(double value, double high) { return std::clamp(value, 0.0, high); }
 //
 // Three regimes by the angle:
 //   - sin > 1e-3: Ericson's clamping (Real-Time Collision Detection 5.1.9): s* clamped, t the
-//     best t for it; if t leaves [0, b] it is clamped and s made the best s for it. Exact for
+//     best t for it; if t leaves [-k, k] it is clamped and s made the best s for it. Exact for
 //     non-parallel segments, and s* is accurate to ~1e-13 relative here.
 //   - 1e-12 < sin <= 1e-3: the distance varies slowly along the segments, and a clamp decided on
 //     a slightly wrong side costs a distance error of order theta a. Appendix A's candidates are
@@ -44,30 +41,26 @@ double clamp(double value, double high) { return std::clamp(value, 0.0, high); }
 // by the library (up to 1e100) overflows or underflows.
 SegmentParameters closest_segment_parameters(const Segment& P, const Segment& Q) {
   const double a = P.length, b = Q.length;
+  const double h = 0.5 * a, k = 0.5 * b;
   const Eigen::Vector3d& u = P.direction;
   const Eigen::Vector3d& v = Q.direction;
-  const Eigen::Vector3d w = P.start - Q.start;
+  const Eigen::Vector3d w = P.middle - Q.middle;
   const double c = u.dot(w), f = v.dot(w), cos = u.dot(v);
+  const auto best_t = [&](double s) { return std::clamp(f + s * cos, -k, k); };
+  const auto best_s = [&](double t) { return std::clamp(t * cos - c, -h, h); };
   SegmentParameters out;
-  if (a == 0.0 && b == 0.0) return out;
-  if (a == 0.0) {
-    out.t = clamp(f, b) / b;
-    return out;
-  }
-  if (b == 0.0) {
-    out.s = clamp(-c, a) / a;
-    return out;
-  }
+  double s = 0.0, t = 0.0;
   const Eigen::Vector3d n = u.cross(v);
   const double sin2 = n.squaredNorm();
-  const auto best_t = [&](double s) { return clamp(f + s * cos, b); };
-  const auto best_s = [&](double t) { return clamp(t * cos - c, a); };
-  double s = 0.0, t = 0.0;
-  if (sin2 > 1e-6) {
-    s = clamp(-w.cross(v).dot(n) / sin2, a);
+  if (a == 0.0 || b == 0.0) {
+    // A point (or two): the middle of a zero-length segment, the other's nearest point to it.
+    t = b == 0.0 ? 0.0 : best_t(0.0);
+    s = a == 0.0 ? 0.0 : best_s(t);
+  } else if (sin2 > 1e-6) {
+    s = std::clamp(-w.cross(v).dot(n) / sin2, -h, h);
     t = f + s * cos;
-    if (t < 0.0 || t > b) {
-      t = clamp(t, b);
+    if (t < -k || t > k) {
+      t = std::clamp(t, -k, k);
       s = best_s(t);
     }
   } else if (sin2 > 1e-24) {
@@ -75,7 +68,7 @@ SegmentParameters closest_segment_parameters(const Segment& P, const Segment& Q)
       return (w + s_ * u - t_ * v).squaredNorm();
     };
     const std::array<std::array<double, 2>, 4> sides = {
-        {{0.0, best_t(0.0)}, {a, best_t(a)}, {best_s(0.0), 0.0}, {best_s(b), b}}};
+        {{-h, best_t(-h)}, {h, best_t(h)}, {best_s(-k), -k}, {best_s(k), k}}};
     double best = distance2(sides[0][0], sides[0][1]);
     s = sides[0][0], t = sides[0][1];
     for (const auto& [s_side, t_side] : sides) {
@@ -84,30 +77,32 @@ SegmentParameters closest_segment_parameters(const Segment& P, const Segment& Q)
     }
     const double s_star = -w.cross(v).dot(n) / sin2;
     const double t_star = f + s_star * cos;  // the best partner of s*, not t*'s own formula
-    if (s_star >= 0.0 && s_star <= a && t_star >= 0.0 && t_star <= b &&
+    if (s_star >= -h && s_star <= h && t_star >= -k && t_star <= k &&
         distance2(s_star, t_star) < best) {
       s = s_star, t = t_star;
     }
   } else {
-    // Parallel: the ends of Q project onto P's line at s0 (t = 0) and s1 (t = b). Where the
-    // projections overlap [0, a], every s of the overlap has a partner at the same distance and
+    // Parallel: the ends of Q project onto P's line at s0 (t = -k) and s1 (t = k). Where the
+    // projections overlap [-h, h], every s of the overlap has a partner at the same distance and
     // the middle of the overlap is returned; otherwise the facing ends are unique.
-    const double s0 = -c, s1 = b * cos - c;
-    const double low = std::max(0.0, std::min(s0, s1));
-    const double high = std::min(a, std::max(s0, s1));
+    const double s0 = -k * cos - c, s1 = k * cos - c;
+    const double low = std::max(-h, std::min(s0, s1));
+    const double high = std::min(h, std::max(s0, s1));
     if (low <= high) {
       s = 0.5 * (low + high);
       t = best_t(s);
       out.overlap = low < high;
       out.half_overlap = 0.5 * (high - low) / a;
     } else {
-      s = clamp(0.5 * (s0 + s1), a);
+      s = std::clamp(0.5 * (s0 + s1), -h, h);
       t = best_t(s);
       s = best_s(t);
     }
   }
-  out.s = s / a;
-  out.t = t / b;
+  out.s_offset = s;
+  out.t_offset = t;
+  out.s = a > 0.0 ? s / a + 0.5 : 0.5;
+  out.t = b > 0.0 ? t / b + 0.5 : 0.5;
   return out;
 }
 

@@ -29,10 +29,10 @@ struct EdgeBound {
 };
 
 EdgeBound edge_bound(const Segment& edge) {
-  const Eigen::Vector3d end = edge.start + edge.length * edge.direction;
-  const bool crosses = (edge.start.z() <= 0.0) != (end.z() <= 0.0) || edge.start.z() == 0.0;
-  return {0.5 * (edge.start + end), 0.5 * edge.length,
-          crosses ? 0.0 : std::min(std::abs(edge.start.z()), std::abs(end.z()))};
+  const Eigen::Vector3d start = edge.at(-0.5 * edge.length), end = edge.at(0.5 * edge.length);
+  const bool crosses = (start.z() <= 0.0) != (end.z() <= 0.0) || start.z() == 0.0;
+  return {edge.middle, 0.5 * edge.length,
+          crosses ? 0.0 : std::min(std::abs(start.z()), std::abs(end.z()))};
 }
 
 enum class Kind {
@@ -181,9 +181,7 @@ void offer_edge_pair(const Segment& edge, const EdgeBound& a_bound, Eigen::Index
     return;
   }
   const SegmentParameters closest = closest_segment_parameters(edge, other);
-  const double distance2 = (edge.start + (closest.s * edge.length) * edge.direction - other.start -
-                            (closest.t * other.length) * other.direction)
-                               .squaredNorm();
+  const double distance2 = (edge.at(closest.s_offset) - other.at(closest.t_offset)).squaredNorm();
   // Parallel edges overlap along intervals of the same length on both.
   const double half_width = closest.half_overlap * edge.length;
   best.offer({distance2, Kind::kEdges, i, j, closest.s, closest.t, half_width, half_width},
@@ -328,7 +326,7 @@ std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
   SmallBuffer<EdgeBound> b_bounds(kb);
   for (Eigen::Index j = 0; j < kb; ++j) {
     const Segment edge = b.edge(j);
-    b_edges[j] = {W.start(j), frame.b_in_a * edge.direction, edge.length};
+    b_edges[j] = {0.5 * (W.start(j) + W.end(j)), frame.b_in_a * edge.direction, edge.length};
     b_bounds[j] = edge_bound(b_edges[j]);
   }
   // Whole polygons (PolygonView) always get every pair: the fast path sends only small ones here,
