@@ -253,11 +253,11 @@ TEST(Degenerate, ParallelBoundaryIsContinuousAtEveryScale) {
 }
 
 // A long capsule (length L from 2^40 up to 2^66 ~ 7e19) with a small shape near its middle, at a
-// gap g = 2^-30 L (the cores intersect below 1e-12 L ~ 2^-40 L): the closest points are computed from the segments' middles, so the long capsule's
-// point keeps the digits of its own offset (0.3 here), and phi is g^2 to rounding. Anchored at the
-// ends, the offset was lost to the rounding of L / 2 (a hostile review: a stick 1e9 beside a
-// 1e20-long capsule got phi 1e18 + 1.2e8 and the point x = 11102 instead of 0.665). Analytic
-// answers, both orders.
+// gap g = 2^-30 L (the cores intersect below 1e-12 L ~ 2^-40 L): the closest points are computed
+// from the segments' middles, so the long capsule's point keeps the digits of its own offset (0.3
+// here), and phi is g^2 to rounding. Anchored at the ends, the offset was lost to the rounding of L
+// / 2 (a hostile review: a stick 1e9 beside a 1e20-long capsule got phi 1e18 + 1.2e8 and the point
+// x = 11102 instead of 0.665). Analytic answers, both orders.
 TEST(Degenerate, ShapesNearTheMiddleOfALongCapsule) {
   Eigen::MatrixX2d C(3, 2);
   C << 0, -1, 1, 1, -1, 1;
@@ -277,8 +277,8 @@ TEST(Degenerate, ShapesNearTheMiddleOfALongCapsule) {
     // middle of the edge's shadow, x = 0.3.
     for (const bool swap : {false, true}) {
       const auto query = [&](const auto& other, const Pose& pose) {
-        const Proximity r = swap ? proximity(other, pose, rod, along_x)
-                                 : proximity(rod, along_x, other, pose);
+        const Proximity r =
+            swap ? proximity(other, pose, rod, along_x) : proximity(rod, along_x, other, pose);
         return std::make_pair(r.phi, r.core_points[swap ? 1 : 0]);
       };
       const auto [phi_dot, on_rod_dot] = query(dot, beside);

@@ -321,10 +321,11 @@ TEST(LargePolygons, FarApartShapesKeepTheirNearSides) {
   };
 
   // The fuzz input: a 51-gon of apothem 3 far below one of apothem 1e70, beside its shadow.
-  const TestShape speck = regular_polygon(51, 3.0), plate = regular_polygon(51, 1.0352619520185846e70);
-  expect_near_side(speck, Pose(Eigen::Vector3d(2.0705239040371691e70, 0, -2.877773982520949e76),
-                               kIdentity),
-                   plate, Pose(Eigen::Vector3d::Zero(), flipped), 2.877773982520949e76);
+  const TestShape speck = regular_polygon(51, 3.0),
+                  plate = regular_polygon(51, 1.0352619520185846e70);
+  expect_near_side(
+      speck, Pose(Eigen::Vector3d(2.0705239040371691e70, 0, -2.877773982520949e76), kIdentity),
+      plate, Pose(Eigen::Vector3d::Zero(), flipped), 2.877773982520949e76);
 
   // A polygon and the same polygon face down, far above, beside its shadow on the ray through a
   // vertex of the first, with a vertex pointing back at it: the nearest pair is those two vertices
@@ -339,16 +340,37 @@ TEST(LargePolygons, FarApartShapesKeepTheirNearSides) {
         const Eigen::Vector3d up(0, 0, height);
         const Pose pa(Eigen::Vector3d::Zero(), kIdentity);
         expect_near_side(a, pa, b, Pose((a.size + b.size + 0.5) * ray + up, flipped), height);
-        const TestShape capsule{Capsule(small, 0.1),
-                                {Eigen::Vector3d(-0.5 * small, 0, 0),
-                                 Eigen::Vector3d(0.5 * small, 0, 0)},
-                                small};
+        const TestShape capsule{
+            Capsule(small, 0.1),
+            {Eigen::Vector3d(-0.5 * small, 0, 0), Eigen::Vector3d(0.5 * small, 0, 0)},
+            small};
         expect_near_side(a, pa, capsule,
                          Pose((a.size + small + 0.5) * ray + up, about(M_PI / count, 0, 0, 1)),
                          height);
       }
     }
   }
+}
+
+// Two equal 51-gons one above the other, 1.4e-9 rad from parallel, their rims over each other:
+// near the lowest pair, vertex pairs differ in distance by 1e-11 of the scene. The windows'
+// sub-problem settled on a neighbouring vertex pair whose direction the supports did not certify,
+// 6e-12 of the scene too far and different in the two orders (found by fuzz_proximity); the
+// certificate is now checked. Both orders against the brute force.
+TEST(LargePolygons, RimsOverEachOtherNearlyParallel) {
+  const double apothem = 1.0352619520185846e70, h = -1.8325506472120096e-06;
+  const TestShape plate = regular_polygon(51, apothem);
+  const Pose pa(Eigen::Vector3d(apothem, 0.0, -64175004669402.219),
+                Eigen::Vector4d(-1.832550644564944e-06, h, h, h));
+  const Pose pb(Eigen::Vector3d(h, h, h), Eigen::Vector4d(h, h, h, h));
+  const auto& polygon = std::get<PaddedPolygon>(plate.shape);
+  const double reference =
+      static_cast<double>(brute_force_closest(to_world(plate, pa), to_world(plate, pb)).distance);
+  const Proximity ab = proximity(polygon, pa, polygon, pb);
+  const Proximity ba = proximity(polygon, pb, polygon, pa);
+  EXPECT_NEAR((ab.core_points[1] - ab.core_points[0]).norm(), reference, 1e-13 * reference);
+  EXPECT_NEAR((ba.core_points[1] - ba.core_points[0]).norm(), reference, 1e-13 * reference);
+  EXPECT_NEAR(ab.phi, ba.phi, 1e-13 * reference * reference);
 }
 
 // A small polygon lying in a large one's plane, 1e-11 rad from parallel (beyond the 1e-12 that

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
+#include <tuple>
 
 #include "diffpills/diffpills.hpp"
 #include "support/scene_helpers.hpp"
@@ -107,6 +108,48 @@ TEST(OptimalSet, SquaresSideBySide) {
   // Touching along the overlap (no gap): the cores meet on the interval.
   expect_middle(big, Pose(), small, Pose({0.75, 0.4, 0}, kIdentity), {0.5, 0.325, 0},
                 {0.5, 0.325, 0});
+}
+
+// Regular polygons side by side, facing edges parallel, the second's plane turned by a small
+// angle about its facing edge (the analytic form of the hostile review's case below). The overlap
+// of the edges x = apothem (y in [-s/2, s/2], s the side) and of the second's, shifted by 0.3 in y,
+// has its middle at y = 0.15; the second's edge is at x = c - apothem cos(angle), z = apothem
+// sin(angle) after the turn about y through its centre c.
+TEST(OptimalSet, ParallelEdgesOfSlightlyTurnedPolygons) {
+  for (const auto& [sides, angle, gap] :
+       {std::tuple{6, 1e-5, 8.66e-6}, std::tuple{8, 3e-6, 1e-5}, std::tuple{6, 1e-7, 1e-3}}) {
+    SCOPED_TRACE(sides);
+    Eigen::MatrixX2d C(sides, 2);
+    for (int k = 0; k < sides; ++k)
+      C.row(k) << std::cos(2 * M_PI * k / sides), std::sin(2 * M_PI * k / sides);
+    const double apothem = 0.5;
+    const PaddedPolygon polygon(C, Eigen::VectorXd::Constant(sides, apothem), 0.05);
+    const double centre = 2 * apothem + gap;
+    const Pose turned({centre, 0.3, 0}, about(angle, 0, 1, 0));
+    expect_middle(polygon, Pose(), polygon, turned, {apothem, 0.15, 0},
+                  {centre - apothem * std::cos(angle), 0.15, apothem * std::sin(angle)});
+  }
+}
+
+// The hostile review's own hexagons (rows at 30 + 60 k degrees) in general position, 8.7e-6
+// apart and turned 1e-5 about the facing edges: one order returned a vertex, the other the
+// middle of the overlap (for 43% of rigid motions), until ties allowed a point candidate its
+// distance from the optimal set, sqrt(2 |d| tau). Both orders: the same points and gradient.
+TEST(OptimalSet, ParallelEdgesOfSlightlyTurnedHexagonsBothOrders) {
+  Eigen::MatrixX2d C(6, 2);
+  for (int k = 0; k < 6; ++k)
+    C.row(k) << std::cos(M_PI / 6 + M_PI / 3 * k), std::sin(M_PI / 6 + M_PI / 3 * k);
+  const PaddedPolygon hexagon(C, Eigen::VectorXd::Constant(6, std::sqrt(0.75)), 0.0);
+  const Pose pa(Eigen::Vector3d::Zero(), Eigen::Vector4d(-0.7954318539860114, 0.46131326228364905,
+                                                         0.272211222074283, -0.2835124164519423));
+  const Pose pb(Eigen::Vector3d(0.863463845767593, 1.4114751468185642, -0.5120235316523538),
+                Eigen::Vector4d(-0.7954318794020803, 0.46131647850229224, 0.2722084865309588,
+                                -0.28350973837532206));
+  const ProximityJacobian ab = proximity_jacobian(hexagon, pa, hexagon, pb);
+  const ProximityJacobian ba = proximity_jacobian(hexagon, pb, hexagon, pa);
+  EXPECT_LE((ab.core_points[0] - ba.core_points[1]).norm(), 1e-9);
+  EXPECT_LE((ab.core_points[1] - ba.core_points[0]).norm(), 1e-9);
+  EXPECT_LE((swap_halves(ba.gradient) - ab.gradient).norm(), 1e-9);
 }
 
 // A box face (a square in a vertical plane) standing on a table: its bottom edge x in [-0.4, 0.6]

@@ -77,12 +77,14 @@ std::array<ClosestFeature, 2> solve_capsule_polygon(const PosedCore& capsule,
     }
   }
   // The overlap wins if it is as close, and a tie within the tie tolerance if the best pair lies
-  // on it (as in separated_polygons.cpp's Best::choice): a tie in distance alone may be another
-  // edge's overlap when the shapes are far apart compared to their size.
+  // on it, give or take sqrt(2 |d| tie_tolerance) (as in separated_polygons.cpp's Best::choice): a
+  // tie in distance alone may be another edge's overlap when the shapes are far apart compared to
+  // their size.
   if (best_overlap.distance2 <= best.distance2) return best_overlap.sides;
   const double reach = std::sqrt(best.distance2) + tie_tolerance;
   if (best_overlap.distance2 > reach * reach) return best.sides;
-  const double reach_of_overlap = best_overlap.half_width + tolerance;
+  const double reach_of_overlap = best_overlap.half_width + tolerance +
+                                  std::sqrt(2.0 * std::sqrt(best.distance2) * tie_tolerance);
   const bool on_overlap =
       (best.sides[0].body_point - best_overlap.sides[0].body_point).norm() <= reach_of_overlap &&
       (best.sides[1].body_point - best_overlap.sides[1].body_point).norm() <= reach_of_overlap;

@@ -24,9 +24,9 @@ PairFrame make_pair_frame(double size_a, double radius_a, double size_b, double 
     frame.inverse_scale = std::ldexp(1.0, -exponent);
   }
   frame.tolerance = 1e-12 * size * frame.inverse_scale;
-  frame.tie_tolerance = (2e-12 * std::max(size_a, size_b) +
-                         64 * std::numeric_limits<double>::epsilon() * size) *
-                        frame.inverse_scale;
+  frame.tie_tolerance =
+      (2e-12 * std::max(size_a, size_b) + 64 * std::numeric_limits<double>::epsilon() * size) *
+      frame.inverse_scale;
   return frame;
 }
 

@@ -34,14 +34,13 @@ inline Sides fast_sides(const Capsule&, const PosedCore& pa, const Capsule&, con
 }
 inline Sides fast_sides(const Capsule&, const PosedCore& pa, const PaddedPolygon& b,
                         const PosedCore& pb, const PairFrame& frame) {
-  return detail::solve_capsule_polygon(pa, PolygonView(b, frame.inverse_scale), pb,
-                                       frame.tolerance, frame.tie_tolerance);
+  return detail::solve_capsule_polygon(pa, PolygonView(b, frame.inverse_scale), pb, frame.tolerance,
+                                       frame.tie_tolerance);
 }
 inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Capsule&,
                         const PosedCore& pb, const PairFrame& frame) {
-  const Sides swapped =
-      detail::solve_capsule_polygon(pb, PolygonView(a, frame.inverse_scale), pa, frame.tolerance,
-                                    frame.tie_tolerance);
+  const Sides swapped = detail::solve_capsule_polygon(pb, PolygonView(a, frame.inverse_scale), pa,
+                                                      frame.tolerance, frame.tie_tolerance);
   return {swapped[1], swapped[0]};
 }
 inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const PaddedPolygon& b,

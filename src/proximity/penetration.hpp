@@ -22,10 +22,10 @@
 // A vertex plus a vertex or an edge is not 2-D, so there are no other facets. Edge pairs whose
 // normal lies within 1e-10 rad of a polygon's face normal are slivers beside that face's facet,
 // left to it (the depth moves by at most 1e-10 of the scene's size; their witnesses are not well
-// defined), as are edge pairs within |sin| <= 1e-12 of parallel (by at most 1e-12). Every candidate's
-// value is h_D at a facet normal, at least the depth, and the nearest facet is among them: their
-// minimum is the depth. The normal-cone tests allow 1e-12 (a cosine, so relative): a candidate
-// admitted within it is below the true h_D(n) by at most 1e-12 of the scene's size.
+// defined), as are edge pairs within |sin| <= 1e-12 of parallel (by at most 1e-12). Every
+// candidate's value is h_D at a facet normal, at least the depth, and the nearest facet is among
+// them: their minimum is the depth. The normal-cone tests allow 1e-12 (a cosine, so relative): a
+// candidate admitted within it is below the true h_D(n) by at most 1e-12 of the scene's size.
 //
 // Where D is flat (two segments, a segment lying in a polygon's plane, coplanar polygons) it has
 // no interior; the candidates +-n of its plane then both give 0, the documented depth.

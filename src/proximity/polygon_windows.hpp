@@ -15,7 +15,6 @@ std::array<ClosestFeature, 2> closest_separated_by_windows(const PolygonView& a,
                                                            const PolygonView& b,
                                                            const PolygonPairFrame& frame,
                                                            const CarriedPolygon<PolygonView>& W,
-                                                           double tolerance,
-                                                           double tie_tolerance);
+                                                           double tolerance, double tie_tolerance);
 
 }  // namespace diffpills::detail

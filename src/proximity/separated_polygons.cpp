@@ -59,20 +59,24 @@ struct Best {
     Candidate& kept = is_interval ? interval : point;
     if (candidate.distance2 < kept.distance2) kept = candidate;
   }
-  // The interval wins if it is as close as the point, and a tie within the tie tolerance (see
+  // The interval wins if it is as close as the point, and a tie within the tie tolerance tau (see
   // fast_paths.hpp) if the point's pair is one of the interval's: each of its two points within
-  // the half width (plus the intersection tolerance) of the interval's middle on that side. A tie
-  // in distance alone does not tell the same optimal set from another feature at almost the same
-  // distance, which happens where the shapes are far apart compared to their size
-  // (pair_frame.hpp). sides_of(candidate): its two sides, each in its body frame.
+  // the half width of the interval's middle on that side, give or take how far a pair within tau
+  // of the optimum can be from the optimal set, sqrt(2 |d| tau) (the distance grows at least
+  // quadratically, with curvature 1 / |d|, away from it; a pair 8.7e-6 apart, its planes 1e-5
+  // rad apart, had its vertex 1.9e-11 beyond the interval's end), plus the intersection
+  // tolerance. A tie in distance alone does not tell the same optimal set from another feature
+  // at almost the same distance, which happens where the shapes are far apart compared to their
+  // size (pair_frame.hpp). sides_of(candidate): its two sides, each in its body frame.
   template <class SidesOf>
   const Candidate& choice(double tolerance, double tie_tolerance, const SidesOf& sides_of) const {
     if (interval.distance2 <= point.distance2) return interval;
     const double reach = std::sqrt(point.distance2) + tie_tolerance;
     if (interval.distance2 > reach * reach) return point;
     const std::array<ClosestFeature, 2> p = sides_of(point), i = sides_of(interval);
-    const bool on_a = (p[0].body_point - i[0].body_point).norm() <= interval.half_width_a + tolerance;
-    const bool on_b = (p[1].body_point - i[1].body_point).norm() <= interval.half_width_b + tolerance;
+    const double slack = tolerance + std::sqrt(2.0 * std::sqrt(point.distance2) * tie_tolerance);
+    const bool on_a = (p[0].body_point - i[0].body_point).norm() <= interval.half_width_a + slack;
+    const bool on_b = (p[1].body_point - i[1].body_point).norm() <= interval.half_width_b + slack;
     return on_a && on_b ? interval : point;
   }
 };
@@ -101,8 +105,14 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
   }
   const auto candidate = [&](Kind b_kind, Kind a_kind, Eigen::Index feature, double parameter,
                              double height, double half_width, double half_shadow) {
-    Candidate c{height * height, polygon_is_b ? b_kind : a_kind, 0, 0, parameter, parameter,
-                polygon_is_b ? half_shadow : half_width, polygon_is_b ? half_width : half_shadow};
+    Candidate c{height * height,
+                polygon_is_b ? b_kind : a_kind,
+                0,
+                0,
+                parameter,
+                parameter,
+                polygon_is_b ? half_shadow : half_width,
+                polygon_is_b ? half_width : half_shadow};
     (polygon_is_b ? c.j : c.i) = feature;
     return c;
   };
