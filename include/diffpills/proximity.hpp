@@ -53,9 +53,11 @@
 //     are solved from their middles, so a shape near the middle of a long capsule keeps its own
 //     digits: a stick 1e9 beside the middle of a 1e20-long capsule gets phi = 1e18 to rounding.
 //     Scaling every length by 2^k scales phi by exactly 2^(2k), the points by 2^k, the
-//     gradient's position part by 2^k and its quaternion part by 2^(2k), bit for bit, while no
-//     length of the scene leaves the normal doubles (below ~1e-290 squares underflow). The normal
-//     is unit to rounding at every scale.
+//     gradient's position part by 2^k and its quaternion part by 2^(2k), bit for bit, while phi,
+//     a squared length, stays a normal double: scenes down to ~1e-154. Below that phi loses
+//     digits to subnormals and below ~1e-162 it underflows to 0 for shapes that are apart
+//     (cores_intersect stays false; the points, the gradient and the signed distance, lengths,
+//     stay exact down to ~1e-290). The normal is unit to rounding at every scale.
 //
 // Errors: shapes and poses validate on construction (std::invalid_argument). The default method
 // never fails on valid shapes. The interior-point reference can: on badly scaled pairs (a core

@@ -137,13 +137,30 @@ py::object first_non_real(const py::array& objects) {
 // width, integers and object arrays of real numbers are values; complex numbers (whose imaginary
 // part a cast would drop), bools and strings are refused rather than guessed at.
 Array as_array(const py::handle& value, const std::string& name) {
+  // A subclass of ndarray is read as its data, which for a masked array would include the values
+  // its mask hides: refused (a hostile review).
+  const auto* ndarray = reinterpret_cast<PyTypeObject*>(py::detail::npy_api::get().PyArray_Type_);
+  if (Py_TYPE(value.ptr()) != ndarray && py::isinstance<py::array>(value) &&
+      py::hasattr(value, "mask")) {
+    throw py::type_error(name + ": a masked array; pass " + name +
+                         ".filled(...) or its unmasked values");
+  }
   // The common case first, at no cost: float64 C-contiguous, used as it is.
   if (Array::check_(value)) return py::reinterpret_borrow<Array>(value);
-  const py::array any = py::isinstance<py::array>(value) ? py::reinterpret_borrow<py::array>(value)
-                                                         : numpy_array(value, py::dtype(), 0, name);
+  // A list or tuple is read as objects first: NumPy would turn [True, 0, 0] into integers and a
+  // bool in it would pass for a number (a hostile review).
+  const bool sequence = PyList_Check(value.ptr()) || PyTuple_Check(value.ptr());
+  const py::array any = py::isinstance<py::array>(value)
+                            ? py::reinterpret_borrow<py::array>(value)
+                            : numpy_array(value, sequence ? py::dtype("O") : py::dtype(), 0, name);
   const char kind = any.dtype().kind();
   if (kind == 'O') {
     if (const py::object entry = first_non_real(any)) {
+      if (sequence && py::isinstance<py::sequence>(entry) && !py::isinstance<py::str>(entry)) {
+        throw py::value_error(name +
+                              ": expected a rectangular array, got nested sequences of "
+                              "different lengths");
+      }
       throw py::type_error(name + ": expected real numbers, got " +
                            (any.ndim() == 0 ? "" : "an array holding ") + type_name(entry));
     }

@@ -154,6 +154,30 @@ def test_arrays_of_non_real_numbers_are_refused_naming_the_argument(kind):
         assert not _pybind11_dump(raised.value)
 
 
+def test_bools_in_lists_and_masked_arrays_are_refused():
+    # NumPy reads [True, 0, 0] as integers and a masked array as its data, hidden values included
+    # (a hostile review); both are refused with TypeError naming the argument.
+    q, r = [1.0, 0.0, 0.0, 0.0], np.zeros((2, 3))
+    capsule = diffpills.Capsule(1.0, 0.1)
+    masked = np.ma.masked_array([0.0, 5.0, 0.0], mask=[0, 1, 0])
+    calls = {
+        "r": [lambda: diffpills.Pose([True, 0, 0], q), lambda: diffpills.Pose((0, 0, False), q),
+              lambda: diffpills.Pose(masked, q)],
+        "q": [lambda: diffpills.Pose([0, 0, 0], [True, 0, 0, 0])],
+        "d": [lambda: diffpills.PaddedPolygon(SQUARE_C, [1, 1, True, 1], 0.1)],
+        "C": [lambda: diffpills.PaddedPolygon([[1, 0], [0, 1], [-1, 0], [0, True]], [1] * 4, 0.1)],
+        "r_a": [lambda: diffpills.proximity_batch(capsule, [[0, 0, 0], [0, True, 0]],
+                                                  np.tile(q, (2, 1)), capsule, r, q)],
+    }
+    for name, bad_calls in calls.items():
+        for call in bad_calls:
+            with pytest.raises(TypeError, match=f"^{name}: ") as raised:
+                call()
+            assert not _pybind11_dump(raised.value)
+    # Lists and tuples of ints, floats and big ints are still numbers.
+    assert list(diffpills.Pose((1, 2.5, 10**30), [1, 0, 0, 0]).r) == [1.0, 2.5, 1e30]
+
+
 @pytest.mark.parametrize(
     "value", [1j, np.complex128(1.0), True, np.bool_(True), "1", None, diffpills.Pose()]
 )
