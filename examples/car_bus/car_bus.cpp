@@ -9,20 +9,37 @@ Pose car_pose(const Eigen::VectorXd& x) {
               Eigen::Vector4d(std::cos(0.5 * x(2)), 0.0, 0.0, std::sin(0.5 * x(2))));
 }
 
-// dphi/dx = [dphi/dr_x, dphi/dr_y, dphi/dq . dq/dtheta, 0, 0] with
-// dq/dtheta = [-sin(theta/2), 0, 0, cos(theta/2)] / 2.
+namespace {
+
+// d/dx of a measure with pose gradient g (the car's 7 entries first): [dg/dr_x, dg/dr_y,
+// dg/dq . dq/dtheta, 0, 0] with dq/dtheta = [-sin(theta/2), 0, 0, cos(theta/2)] / 2.
+void state_gradient(const Eigen::Matrix<double, 14, 1>& g, const Eigen::VectorXd& x,
+                    Eigen::VectorXd* gradient) {
+  if (gradient == nullptr) return;
+  const Eigen::Vector4d dq_dtheta(-0.5 * std::sin(0.5 * x(2)), 0.0, 0.0,
+                                  0.5 * std::cos(0.5 * x(2)));
+  gradient->setZero(5);
+  (*gradient)(0) = g(0);
+  (*gradient)(1) = g(1);
+  (*gradient)(2) = g.segment<4>(3).dot(dq_dtheta);
+}
+
+}  // namespace
+
 double car_bus_phi(const CarBusScenario& scenario, const Eigen::VectorXd& x,
                    Eigen::VectorXd* gradient) {
   const Proximity p = proximity(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
-  if (gradient != nullptr) {
-    const Eigen::Vector4d dq_dtheta(-0.5 * std::sin(0.5 * x(2)), 0.0, 0.0,
-                                    0.5 * std::cos(0.5 * x(2)));
-    gradient->setZero(5);
-    (*gradient)(0) = p.gradient(0);
-    (*gradient)(1) = p.gradient(1);
-    (*gradient)(2) = p.gradient.segment<4>(3).dot(dq_dtheta);
-  }
+  state_gradient(p.gradient, x, gradient);
   return p.phi;
+}
+
+double car_bus_clearance(const CarBusScenario& scenario, const Eigen::VectorXd& x,
+                         Eigen::VectorXd* gradient) {
+  if (scenario.clearance == Clearance::kProximity) return car_bus_phi(scenario, x, gradient);
+  const SignedDistance s =
+      signed_distance(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
+  state_gradient(s.gradient, x, gradient);
+  return s.distance;
 }
 
 CarBusProblem::CarBusProblem(CarBusScenario scenario) : scenario_(std::move(scenario)) {
@@ -80,7 +97,8 @@ trajopt::KnotConstraints CarBusProblem::constraint_values(int k, const Eigen::Ve
   return evaluate_constraints(k, x, u, false);
 }
 
-// Rows: [equalities: px, py, theta - goal (last knot only)], -phi, then u - limit, -u - limit.
+// Rows: [equalities: px, py, theta - goal (last knot only)], -clearance, then u - limit,
+// -u - limit.
 trajopt::KnotConstraints CarBusProblem::evaluate_constraints(int k, const Eigen::VectorXd& x,
                                                              const Eigen::VectorXd& u,
                                                              bool derivatives) const {
@@ -99,7 +117,7 @@ trajopt::KnotConstraints CarBusProblem::evaluate_constraints(int k, const Eigen:
     if (derivatives) c.dx.topLeftCorner<3, 3>().setIdentity();
   }
   Eigen::VectorXd gradient;
-  c.value(equalities) = -car_bus_phi(scenario_, x, derivatives ? &gradient : nullptr);
+  c.value(equalities) = -car_bus_clearance(scenario_, x, derivatives ? &gradient : nullptr);
   if (derivatives) c.dx.row(equalities) = -gradient.transpose();
   if (!last) {
     for (int i = 0; i < 2; ++i) {

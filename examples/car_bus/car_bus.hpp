@@ -10,7 +10,13 @@
 
 namespace diffpills::examples {
 
+// The measure the collision constraints keep >= 0: the paper's proximity phi, flat (zero gradient)
+// wherever the cores intersect, or the signed distance, whose slope points out of the bus also
+// there (signed_distance.hpp).
+enum class Clearance { kProximity, kSignedDistance };
+
 struct CarBusScenario {
+  Clearance clearance = Clearance::kProximity;
   double dt = 0.1;
   int knots = 51;
   trajopt::Car car_model{2.5};
@@ -28,10 +34,13 @@ Pose car_pose(const Eigen::VectorXd& x);
 // phi(car at x, bus) and its gradient with respect to the state (through the pose).
 double car_bus_phi(const CarBusScenario& scenario, const Eigen::VectorXd& x,
                    Eigen::VectorXd* gradient = nullptr);
+// The scenario's clearance measure (phi or the signed distance) and its state gradient.
+double car_bus_clearance(const CarBusScenario& scenario, const Eigen::VectorXd& x,
+                         Eigen::VectorXd* gradient = nullptr);
 
 // Costs 1/2 (x - goal)'Q(x - goal) + 1/2 u'Ru per knot and 1/2 (x - goal)'Qf(x - goal) at the
-// end; constraints -phi <= 0 at every knot, |u| <= control_limit at every control, and the final
-// position and heading equal to the goal's.
+// end; constraints -clearance <= 0 at every knot (phi or the signed distance), |u| <= control_limit
+// at every control, and the final position and heading equal to the goal's.
 class CarBusProblem : public trajopt::Problem {
  public:
   explicit CarBusProblem(CarBusScenario scenario);
