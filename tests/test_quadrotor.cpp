@@ -112,8 +112,13 @@ TEST(Quadrotor, HoverBalancesGravityAndRotorsTurnTheRightWay) {
 // polygon-polygon and polygon-capsule paths) against central differences of the values, at
 // random states around the window and the poles. A state whose difference quotient straddles an
 // active-set change (phi is C1 but its gradient kinks there) may differ; at most 1% may.
-TEST(Quadrotor, WindowConstraintGradientsMatchCentralDifferences) {
-  const examples::QuadrotorWindowProblem problem{examples::QuadrotorWindowScenario{}};
+// Both clearances: phi and the signed distance (a kink there is a change of nearest facet).
+class WindowConstraintGradients : public ::testing::TestWithParam<examples::Clearance> {};
+
+TEST_P(WindowConstraintGradients, MatchCentralDifferences) {
+  examples::QuadrotorWindowScenario scenario;
+  scenario.clearance = GetParam();
+  const examples::QuadrotorWindowProblem problem{scenario};
   std::mt19937_64 rng(22);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const double e = 1e-6;
@@ -143,6 +148,9 @@ TEST(Quadrotor, WindowConstraintGradientsMatchCentralDifferences) {
   std::cout << "[quadrotor] constraint gradients: " << mismatched << " of " << checked
             << " rows off (active-set changes)\n";
 }
+INSTANTIATE_TEST_SUITE_P(Quadrotor, WindowConstraintGradients,
+                         ::testing::Values(examples::Clearance::kProximity,
+                                           examples::Clearance::kSignedDistance));
 
 // The world corners of a rectangle [s0, s1] x [t0, t1] of the tilted wall, from its definition:
 // s runs across the window (world y turned by the tilt about x), t along it (world z turned).
@@ -167,6 +175,38 @@ testing::WorldCore body_square(const examples::QuadrotorWindowScenario& s, const
         (x.head<3>() + q.normalized() * Vector3d(bx, by, 0.0)).cast<long double>());
   }
   return core;
+}
+
+// The smallest phi over the obstacles at state x, and the smallest gap between the padded shapes
+// (distance of the cores minus the radii), by the brute-force reference on the world cores built
+// here from the scenario's fields (not the library's shapes).
+struct BruteForceClearance {
+  double phi = INFINITY, gap = INFINITY;
+};
+BruteForceClearance brute_force_clearance(const examples::QuadrotorWindowScenario& s,
+                                          const VectorXd& x) {
+  const double half_gap = 0.5 * s.window_width + s.wall_radius,
+               half_height = 0.5 * s.window_height + s.wall_radius, w = s.wall_half_size;
+  std::vector<std::pair<testing::WorldCore, double>> obstacles = {
+      {wall_rectangle(s, -w, -half_gap, -w, w), s.wall_radius},
+      {wall_rectangle(s, half_gap, w, -w, w), s.wall_radius},
+      {wall_rectangle(s, -half_gap, half_gap, -w, -half_height), s.wall_radius},
+      {wall_rectangle(s, -half_gap, half_gap, half_height, w), s.wall_radius}};
+  for (const auto& pole : s.poles) {  // vertical segments from the ground, by construction
+    const Vector3d foot(pole.pose.r()(0), pole.pose.r()(1), 0.0);
+    obstacles.push_back({{{foot.cast<long double>(),
+                           (foot + Vector3d(0, 0, pole.shape.length())).cast<long double>()}},
+                         pole.shape.radius()});
+  }
+  const testing::WorldCore body = body_square(s, x);
+  BruteForceClearance out;
+  for (const auto& [core, radius] : obstacles) {
+    const double d = static_cast<double>(testing::brute_force_closest(body, core).distance);
+    const double sum = s.body_radius + radius;
+    out.phi = std::min(out.phi, d * d - sum * sum);
+    out.gap = std::min(out.gap, d - sum);
+  }
+  return out;
 }
 
 // x' of the documented model, written out again with Eigen's quaternion algebra.
@@ -202,32 +242,10 @@ TEST(Quadrotor, FliesThroughTheTiltedWindow) {
   ASSERT_EQ(result.status, AltroStatus::kSolved) << to_string(result.status);
   EXPECT_LE(result.max_violation, 1e-6);
 
-  const double half_gap = 0.5 * s.window_width + s.wall_radius,
-               half_height = 0.5 * s.window_height + s.wall_radius, w = s.wall_half_size;
-  const std::vector<testing::WorldCore> panels = {
-      wall_rectangle(s, -w, -half_gap, -w, w), wall_rectangle(s, half_gap, w, -w, w),
-      wall_rectangle(s, -half_gap, half_gap, -w, -half_height),
-      wall_rectangle(s, -half_gap, half_gap, half_height, w)};
-  std::vector<testing::WorldCore> poles;
-  for (const auto& pole : s.poles) {  // vertical segments from the ground, by construction
-    const Vector3d foot(pole.pose.r()(0), pole.pose.r()(1), 0.0);
-    poles.push_back({{foot.cast<long double>(),
-                      (foot + Vector3d(0, 0, pole.shape.length())).cast<long double>()}});
-  }
   double min_phi = INFINITY, largest_tilt = 0.0;
   for (int k = 0; k < s.knots; ++k) {
     const VectorXd& x = result.states[k];
-    const testing::WorldCore body = body_square(s, x);
-    for (const auto& panel : panels) {
-      const long double d = testing::brute_force_closest(body, panel).distance;
-      const double sum = s.body_radius + s.wall_radius;
-      min_phi = std::min(min_phi, static_cast<double>(d * d) - sum * sum);
-    }
-    for (std::size_t i = 0; i < poles.size(); ++i) {
-      const long double d = testing::brute_force_closest(body, poles[i]).distance;
-      const double sum = s.body_radius + s.poles[i].shape.radius();
-      min_phi = std::min(min_phi, static_cast<double>(d * d) - sum * sum);
-    }
+    min_phi = std::min(min_phi, brute_force_clearance(s, x).phi);
     largest_tilt = std::max(largest_tilt, std::acos(1.0 - 2.0 * (x(4) * x(4) + x(5) * x(5))));
     EXPECT_NEAR(x.segment<4>(3).norm(), 1.0, 1e-9) << "knot " << k;
     if (k + 1 < s.knots) {
@@ -251,6 +269,34 @@ TEST(Quadrotor, FliesThroughTheTiltedWindow) {
             << result.max_violation << ", smallest phi (brute force) " << min_phi
             << ", largest tilt " << largest_tilt * 180.0 / M_PI << " deg, level straight line "
             << level_min_phi << "\n";
+}
+
+// A thin wall (panels and body padded by 0.025 m each, 0.05 in sum) for horizons of 31 to 81
+// knots: with phi as the clearance, augmented-Lagrangian iterates that cross an obstacle's core
+// stay stuck where phi is flat (measured: all six horizons end at the iteration cap, inside a
+// pole); with the signed distance, whose slope leads out of the crossing (the body's square and a
+// panel or pole are not coplanar, so their Minkowski difference has depth), every horizon is
+// solved. Checked by brute force: every knot clear, the goal reached.
+TEST(Quadrotor, ThinWallIsSolvedWithTheSignedDistance) {
+  for (int knots = 31; knots <= 81; knots += 10) {
+    SCOPED_TRACE(knots);
+    examples::QuadrotorWindowScenario scenario;
+    scenario.wall_radius = 0.025;
+    scenario.body_radius = 0.025;
+    scenario.knots = knots;
+    scenario.clearance = examples::Clearance::kSignedDistance;
+    scenario.build();
+    const examples::QuadrotorWindowProblem problem{scenario};
+    const examples::QuadrotorWindowScenario& s = problem.scenario();
+    const AltroResult result = solve(problem, s.x0, problem.hover_controls());
+    ASSERT_EQ(result.status, AltroStatus::kSolved) << to_string(result.status);
+    double smallest_gap = INFINITY;
+    for (const VectorXd& x : result.states) {
+      smallest_gap = std::min(smallest_gap, brute_force_clearance(s, x).gap);
+    }
+    EXPECT_GE(smallest_gap, -1e-6);
+    EXPECT_LE((result.states.back().head<3>() - s.goal.head<3>()).cwiseAbs().maxCoeff(), 1e-6);
+  }
 }
 
 }  // namespace

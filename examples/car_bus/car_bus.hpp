@@ -4,16 +4,12 @@
 
 #include <Eigen/Core>
 
+#include "clearance.hpp"
 #include "diffpills/diffpills.hpp"
 #include "diffpills/trajopt/altro.hpp"
 #include "diffpills/trajopt/car.hpp"
 
 namespace diffpills::examples {
-
-// The measure the collision constraints keep >= 0: the paper's proximity phi, flat (zero gradient)
-// wherever the cores intersect, or the signed distance, whose slope points out of the bus also
-// there (signed_distance.hpp).
-enum class Clearance { kProximity, kSignedDistance };
 
 struct CarBusScenario {
   Clearance clearance = Clearance::kProximity;

@@ -59,11 +59,17 @@ Eigen::VectorXd hover_state(double x, double y, double z) {
 // - phi's gradient vanishes once the cores intersect (proximity.hpp), which happens when an iterate
 //   penetrates deeper than the sum of the radii; with 0.05 m panels and body padding, early AL
 //   iterates got stuck at phi = -(R1 + R2)^2 for some horizons. The padding here (0.25 m in sum)
-//   keeps every horizon from 31 to 81 knots solvable (measured).
+//   keeps every horizon from 31 to 81 knots solvable (measured). The signed distance as the
+//   clearance (Clearance::kSignedDistance) keeps its slope there and solves thin walls too.
 QuadrotorWindowScenario::QuadrotorWindowScenario()
     : body(padded_rectangle(body_half_side, body_half_side, body_radius)),
       x0(hover_state(0.0, 0.0, 1.5)),
       goal(hover_state(6.0, 0.0, 1.5)) {
+  build();
+}
+
+void QuadrotorWindowScenario::build() {
+  body = padded_rectangle(body_half_side, body_half_side, body_radius);
   const double radius = wall_radius, half_wall = wall_half_size;
   const double half_gap = 0.5 * window_width + radius, half_height = 0.5 * window_height + radius;
   wall = {
@@ -141,8 +147,8 @@ trajopt::KnotConstraints QuadrotorWindowProblem::constraint_values(int k, const 
   return evaluate_constraints(k, x, u, false);
 }
 
-// Rows: [equalities: r - goal position (last knot only)], -phi per obstacle (wall panels, then
-// poles), then u - thrust_max and -u. d(-phi)/dx takes the proximity gradient's first seven
+// Rows: [equalities: r - goal position (last knot only)], -clearance per obstacle (wall panels,
+// then poles), then u - thrust_max and -u. d(-phi)/dx takes the measure's gradient's first seven
 // entries (d/dr, d/dq of the body, the first shape) as they are: q is the state's own quaternion,
 // and the library's gradient already includes the normalization of q.
 trajopt::KnotConstraints QuadrotorWindowProblem::evaluate_constraints(int k,
@@ -166,17 +172,21 @@ trajopt::KnotConstraints QuadrotorWindowProblem::evaluate_constraints(int k,
   }
   const Pose pose = quadrotor_pose(x);
   int row = equalities;
-  const auto add = [&](const Proximity& p) {
-    c.value(row) = -p.phi;
-    if (derivatives) c.dx.row(row).head<7>() = -p.gradient.head<7>().transpose();
+  const auto add = [&](const auto& obstacle) {
+    const bool phi = scenario_.clearance == Clearance::kProximity;
+    if (phi) {
+      const Proximity p = proximity(scenario_.body, pose, obstacle.shape, obstacle.pose);
+      c.value(row) = -p.phi;
+      if (derivatives) c.dx.row(row).head<7>() = -p.gradient.head<7>().transpose();
+    } else {
+      const SignedDistance s = signed_distance(scenario_.body, pose, obstacle.shape, obstacle.pose);
+      c.value(row) = -s.distance;
+      if (derivatives) c.dx.row(row).head<7>() = -s.gradient.head<7>().transpose();
+    }
     ++row;
   };
-  for (const PosedPolygon& panel : scenario_.wall) {
-    add(proximity(scenario_.body, pose, panel.shape, panel.pose));
-  }
-  for (const PosedCapsule& p : scenario_.poles) {
-    add(proximity(scenario_.body, pose, p.shape, p.pose));
-  }
+  for (const PosedPolygon& panel : scenario_.wall) add(panel);
+  for (const PosedCapsule& p : scenario_.poles) add(p);
   if (!last) {
     for (int i = 0; i < 4; ++i) {
       c.value(row + i) = u(i) - scenario_.thrust_max;

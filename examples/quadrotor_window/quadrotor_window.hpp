@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "clearance.hpp"
 #include "diffpills/diffpills.hpp"
 #include "diffpills/trajopt/altro.hpp"
 #include "diffpills/trajopt/quadrotor.hpp"
@@ -28,7 +29,10 @@ struct PosedCapsule {
 
 struct QuadrotorWindowScenario {
   QuadrotorWindowScenario();
+  // Rebuilds body, wall and poles from the fields above them (after changing a size).
+  void build();
 
+  Clearance clearance = Clearance::kProximity;  // the constraints' measure
   double dt = 0.06;
   int knots = 51;  // 3 s
   trajopt::Quadrotor model;
@@ -51,11 +55,12 @@ struct QuadrotorWindowScenario {
 // The body's pose at state x: r = x[0:3], q = x[3:7].
 Pose quadrotor_pose(const Eigen::VectorXd& x);
 
-// The smallest phi over the obstacles at state x.
+// The smallest phi over the obstacles at state x (whatever the scenario's clearance).
 double quadrotor_min_phi(const QuadrotorWindowScenario& scenario, const Eigen::VectorXd& x);
 
 // Costs 1/2 (x - goal)'Q(x - goal) + 1/2 (u - hover)'R(u - hover) per knot and
-// 1/2 (x - goal)'Qf(x - goal) at the end; constraints -phi <= 0 for every obstacle at every knot,
+// 1/2 (x - goal)'Qf(x - goal) at the end; constraints -clearance <= 0 (phi or the signed
+// distance) for every obstacle at every knot,
 // 0 <= u <= thrust_max, and the final position equal to the goal's.
 class QuadrotorWindowProblem : public trajopt::Problem {
  public:
