@@ -47,7 +47,8 @@ fuzz: fuzz-build
 	bash scripts/run-fuzzers.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
 
 # The motion-planning demo (car-bus and quadrotor-window problems: out/*.csv, *.json, *.svg), then
-# the Python example that untangles a heap of shapes (out/untangle_{before,after}.png).
+# the Python example that untangles a 3-D heap of crossing shapes with the signed distance
+# (out/untangle_{before,after}.png).
 demo: build
 	./$(BUILD)/examples/diffpills_demo out
 	PYTHONPATH=$(BUILD)/python MPLBACKEND=Agg $(PYTHON) examples/python/untangle.py out

@@ -15,8 +15,9 @@
 //   - the interior-point reference agrees with the default path on phi (one pair in four);
 //   - proximity_batch over a few rows and threads equals the single calls bit for bit;
 //   - the signed distance: finite, a unit normal, swap symmetry, points[1] - points[0] =
-//     distance * normal, and agreement with proximity()'s closest points where the cores are
-//     apart (distance + R1 + R2 = |p1 - p2|) or at most -(R1 + R2) where they intersect.
+//     distance * normal with the witnesses on the cores, and agreement with proximity()'s
+//     closest points where the cores are apart (distance + R1 + R2 = |p1 - p2|) or at most
+//     -(R1 + R2) where they intersect.
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <Eigen/Core>
@@ -188,6 +189,23 @@ Eigen::Index rows_of(const Shape& shape) {
   return polygon == nullptr ? 0 : polygon->vertices().rows();
 }
 
+// How far a world point lies off a shape's core (up to a factor of order one for a polygon: the
+// larger of its height over the plane and its largest row violation).
+double off_core(const Shape& shape, const Pose& pose, const Eigen::Vector3d& point) {
+  const Eigen::Vector3d y = diffpills::rotation_matrix(pose.q()).transpose() * (point - pose.r());
+  if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+    const double along = std::max(std::abs(y.x()) - 0.5 * capsule->length(), 0.0);
+    return std::hypot(along, std::hypot(y.y(), y.z()));
+  }
+  const auto& polygon = std::get<PaddedPolygon>(shape);
+  double outside = 0.0;
+  for (Eigen::Index i = 0; i < polygon.edge_normals().rows(); ++i) {
+    outside = std::max(outside,
+                       polygon.edge_normals().row(i).dot(y.head<2>()) - polygon.edge_offsets()(i));
+  }
+  return std::max(std::abs(y.z()), outside);
+}
+
 void check_result(const diffpills::ProximityJacobian& result, double radii) {
   check(std::isfinite(result.phi), "phi is finite", result.phi);
   check(result.gradient.allFinite(), "gradient is finite");
@@ -240,13 +258,15 @@ void check_signed_distance(const Shape& a, const Pose& pose_a, const Shape& b, c
   check(std::abs(ab.distance - ba.distance) <= tolerance, "swap symmetry of the signed distance",
         ab.distance - ba.distance);
 
-  // In penetration the witnesses may be the closest points, off the facet by the depth (a known
-  // limitation, signed_distance.hpp).
-  const double depth = ab.penetrating ? std::abs(ab.distance + radii) : 0.0;
   check((ab.points[1] - ab.points[0] - ab.distance * ab.normal).stableNorm() <=
-            tolerance + representable + depth,
+            tolerance + representable,
         "points[1] - points[0] = distance * normal",
         (ab.points[1] - ab.points[0] - ab.distance * ab.normal).stableNorm());
+  // The witnesses lie on the cores (a facet is taken only if its nearest point lies on it).
+  check(off_core(a, pose_a, ab.core_points[0]) <= tolerance + representable, "witness on core 1",
+        off_core(a, pose_a, ab.core_points[0]));
+  check(off_core(b, pose_b, ab.core_points[1]) <= tolerance + representable, "witness on core 2",
+        off_core(b, pose_b, ab.core_points[1]));
   if (ab.penetrating) {
     check(ab.distance <= -radii + tolerance, "penetrating: distance <= -(R1 + R2)", ab.distance);
   } else {

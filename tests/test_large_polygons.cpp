@@ -1,7 +1,9 @@
 // Polygons with many vertices: the window path (polygon_windows.hpp), which makes a pair cost about
 // linear in the vertex counts, must give the answer of the full enumeration it replaces above
 // 32 x 32 vertices, and of the brute-force reference. Both paths are called directly on the same
-// pairs; the public queries use the windows for these sizes.
+// pairs; the public queries use the windows for these sizes. The same for the signed distance in
+// penetration, whose search of the edge chains' hierarchies (edge_chain_tree.hpp) replaces the
+// visit of every edge pair there, against that visit and a separating-axis brute force.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -9,7 +11,9 @@
 #include <random>
 
 #include "diffpills/diffpills.hpp"
+#include "proximity/core_outline.hpp"
 #include "proximity/pair_frame.hpp"
+#include "proximity/penetration.hpp"
 #include "proximity/polygon_windows.hpp"
 #include "proximity/separated_polygons.hpp"
 #include "support/random_shapes.hpp"
@@ -402,6 +406,101 @@ TEST(LargePolygons, NearlyCoplanarOverlapIsAnIntersection) {
     EXPECT_NEAR(ab.core_points[1].x(), 0.5 + 0.5 * (2.75 - far_end), 1e-4);
     EXPECT_LE((ab.core_points[1] - ba.core_points[0]).norm(), 1e-9 * 41402.0);
   }
+}
+
+// The penetration search of two polygons in one frame of scale 1 (the inputs are of order one):
+// pruned by the edge chains' hierarchies (as the public query above 32 x 32 vertices) or visiting
+// every edge pair.
+struct PenetrationPaths {
+  detail::DeepestFacet pruned, every;
+  detail::PosedCore a, b;
+};
+
+PenetrationPaths penetration_paths(const PaddedPolygon& a, const Pose& pa, const PaddedPolygon& b,
+                                   const Pose& pb) {
+  const detail::PolygonView view_a(a, 1.0), view_b(b, 1.0);
+  PenetrationPaths out{{},
+                       {},
+                       {pa.r(), detail::UnitQuaternion(pa.q()), 0.0, a.extent()},
+                       {pb.r(), detail::UnitQuaternion(pb.q()), 0.0, b.extent()}};
+  const detail::PairFrame scales =
+      detail::make_pair_frame(a.extent(), 0.0, b.extent(), 0.0, pa.r(), pb.r());
+  const double tolerance = scales.tolerance * scales.scale;
+  const detail::CoreOutline outline_a(view_a, out.a), outline_b(view_b, out.b);
+  out.pruned = detail::deepest_facet(outline_a, outline_b, tolerance);
+  out.every =
+      detail::deepest_facet(outline_a, outline_b, tolerance, detail::EdgePairVisits::kEvery);
+  return out;
+}
+
+// Random pairs of 33 to 120 vertices, crossing at random attitudes, at right angles and nearly
+// coplanar (where D is thin and many facets are nearly as deep): the pruned search finds the depth
+// of the separating-axis brute force and of the visit of every pair, and its facet's witnesses lie
+// on the two cores, x1 - x2 = depth * normal.
+TEST(LargePolygons, PenetrationSearchAgreesWithEveryPairAndSeparatingAxes) {
+  Rng rng(23);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  int penetrating = 0;
+  for (int i = 0; i < 240; ++i) {
+    const int ka = std::uniform_int_distribution<int>(33, 120)(rng);
+    const int kb = std::uniform_int_distribution<int>(33, 120)(rng);
+    const TestShape a = many_sided(rng, ka, i % 5 == 0), b = many_sided(rng, kb, i % 7 == 0);
+    const Pose pa = random_pose(rng, 0.3);
+    Pose pb = random_pose(rng, 0.3);
+    if (i % 3 != 0) {
+      // b turned off a's plane by 90 degrees (i % 3 == 1) or by 10^-2 .. 10^-10 rad.
+      const Eigen::Quaterniond qa(pa.q()(0), pa.q()(1), pa.q()(2), pa.q()(3));
+      const double tilt = i % 3 == 1 ? M_PI / 2 : std::pow(10.0, -2.0 - 8.0 * uniform(rng));
+      const Eigen::Quaterniond qb =
+          qa.normalized() *
+          Eigen::Quaterniond(Eigen::AngleAxisd(
+              tilt, Eigen::Vector3d(uniform(rng) - 0.5, uniform(rng) - 0.5, 0).normalized())) *
+          Eigen::Quaterniond(Eigen::AngleAxisd(6.3 * uniform(rng), Eigen::Vector3d::UnitZ()));
+      pb = Pose(pb.r(), Eigen::Vector4d(qb.w(), qb.x(), qb.y(), qb.z()));
+    }
+    const WorldCore wa = to_world(a, pa), wb = to_world(b, pb);
+    if (brute_force_closest(wa, wb).distance > 0) continue;  // apart: not a penetration
+    ++penetrating;
+    const PenetrationPaths paths = penetration_paths(std::get<PaddedPolygon>(a.shape), pa,
+                                                     std::get<PaddedPolygon>(b.shape), pb);
+    const double reference = static_cast<double>(brute_force_penetration_depth(wa, wb));
+    ASSERT_NEAR(paths.pruned.depth, reference, 1e-12) << i;
+    ASSERT_NEAR(paths.every.depth, reference, 1e-12) << i;
+    if (paths.pruned.depth <= 1e-12) continue;  // touching: the closest points serve
+    ASSERT_TRUE(paths.pruned.witnesses.has_value()) << i;
+    const Eigen::Vector3d x1 = world(paths.a, (*paths.pruned.witnesses)[0]);
+    const Eigen::Vector3d x2 = world(paths.b, (*paths.pruned.witnesses)[1]);
+    ASSERT_LE(distance_to_core(x1, wa), 1e-12) << i;
+    ASSERT_LE(distance_to_core(x2, wb), 1e-12) << i;
+    ASSERT_LE((x1 - x2 - paths.pruned.depth * paths.pruned.normal).norm(), 1e-12) << i;
+  }
+  EXPECT_GT(penetrating, 120);
+}
+
+// Two regular 10^5-gons crossing at right angles (a hostile review's stall: every pair of edges is
+// a facet of D, and visiting them all took minutes): analytic answers. The disc of circumradius
+// 0.7 stands in the plane x = 0 with its centre 0.3 above the unit disc's, its lowest vertex 0.4
+// below the unit disc's plane; lifting it by 0.4 is the shortest way out (any tilt of the
+// translation costs more: h_D(n) = |n_xy| + 0.7 |n_yz| - 0.3 n_z).
+TEST(LargePolygons, HundredThousandGonsCrossing) {
+  const auto regular = [](int count, double circumradius) {
+    Eigen::MatrixX2d C(count, 2);
+    for (int k = 0; k < count; ++k)
+      C.row(k) << std::cos(2 * M_PI * (k + 0.5) / count), std::sin(2 * M_PI * (k + 0.5) / count);
+    return PaddedPolygon(C, Eigen::VectorXd::Constant(count, circumradius * std::cos(M_PI / count)),
+                         0.01);
+  };
+  const PaddedPolygon large = regular(100000, 1.0), small = regular(100000, 0.7);
+  const Pose standing({0, 0, 0.3}, about(M_PI / 2, 0, 1, 0));  // body z along world x
+  const SignedDistance sd = signed_distance(large, Pose(), small, standing);
+  EXPECT_TRUE(sd.penetrating);
+  EXPECT_NEAR(sd.distance, -0.42, 1e-12);
+  EXPECT_NEAR((sd.normal - Eigen::Vector3d::UnitZ()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((sd.core_points[1] - Eigen::Vector3d(0, 0, -0.4)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((sd.core_points[0] - Eigen::Vector3d(0, 0, 0)).norm(), 0.0, 1e-12);
+  const SignedDistance swapped = signed_distance(small, standing, large, Pose());
+  EXPECT_NEAR(swapped.distance, -0.42, 1e-12);
+  EXPECT_NEAR((swapped.normal + Eigen::Vector3d::UnitZ()).norm(), 0.0, 1e-12);
 }
 
 }  // namespace

@@ -186,5 +186,19 @@ TEST(OptimalSet, StackedSquares) {
                 {0.425, 0.375, 0}, {0.425, 0.375, 0.3});
 }
 
+// Stacked regular octagons whose rows of one direction straddle the angle 0, the second turned by
+// -1e-158 rad (a row normal (1, -1e-158) sorts just below 2 pi, its twin (1, 0) at 0): the overlap
+// of their shadows is the whole octagon, not empty (fuzz_proximity found the overlap empty in
+// one order of two such polygons and a rim point in place of the centroid).
+TEST(OptimalSet, StackedPolygonsWithRowsAcrossAngleZero) {
+  Eigen::MatrixX2d C(8, 2);
+  for (int k = 0; k < 8; ++k) C.row(k) << std::cos(M_PI * k / 4), std::sin(M_PI * k / 4);
+  const PaddedPolygon octagon(C, Eigen::VectorXd::Ones(8), 0.1);
+  for (const double turn : {-1e-158, -1e-13, 1e-13}) {
+    expect_middle(octagon, Pose(), octagon, Pose({0, 0, 0.5}, Eigen::Vector4d(1, 0, 0, 0.5 * turn)),
+                  {0, 0, 0}, {0, 0, 0.5});
+  }
+}
+
 }  // namespace
 }  // namespace diffpills::testing

@@ -119,9 +119,11 @@ TEST(SignedDistance, AgreesWithBruteForceHullOnTenThousandPairs) {
       worst = std::max(worst, error);
       ASSERT_LE(error, 1e-9) << name(pair) << " case " << i << ": ours " << ours.distance
                              << ", hull " << expected;
-      // The witnesses: points[1] - points[0] = distance * normal, within the surfaces' reach.
+      // The witnesses: points[1] - points[0] = distance * normal, on the two cores.
       EXPECT_LE((ours.points[1] - ours.points[0] - ours.distance * ours.normal).norm(),
                 1e-9 * scale);
+      EXPECT_LE(distance_to_core(ours.core_points[0], to_world(c.a, c.pose_a)), 1e-12L * scale);
+      EXPECT_LE(distance_to_core(ours.core_points[1], to_world(c.b, c.pose_b)), 1e-12L * scale);
       EXPECT_NEAR(ours.normal.norm(), 1.0, 1e-14);
       if (reference.s < -1e-6L * scale) {
         ++penetrating;
@@ -133,6 +135,60 @@ TEST(SignedDistance, AgreesWithBruteForceHullOnTenThousandPairs) {
     if (pair != Pair::kCapsuleCapsule) {
       EXPECT_GT(penetrating, 400);  // (the D of two segments is flat: s >= 0)
     }
+  }
+}
+
+// Cores crossing nearly coplanar (10^-2 .. 10^-12 rad): D is thin and many of its facets are
+// nearly as deep as the nearest one. The chosen facet's witnesses must lie on the two cores
+// (choosing among all facets, a tie-break once took one whose nearest point was off it, and the
+// witnesses lay off the cores by up to the scene's size), points[1] - points[0] = distance *
+// normal, and the depth is the separating-axis brute force's.
+TEST(SignedDistance, NearlyCoplanarCrossingsHaveWitnessesOnTheCores) {
+  Rng rng(20261124);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (const Pair pair : {Pair::kPolygonPolygon, Pair::kCapsulePolygon}) {
+    int penetrating = 0;
+    double worst_off = 0.0, worst_depth = 0.0;
+    for (int i = 0; i < 3000; ++i) {
+      Case c = random_case(rng, pair, 1.0, 0.0);
+      // a's plane (or a capsule's axis) turned off b's plane by the tilt, a's origin near b's
+      // plane.
+      const Eigen::Quaterniond base =
+          Eigen::Quaterniond(c.pose_b.q()(0), c.pose_b.q()(1), c.pose_b.q()(2), c.pose_b.q()(3))
+              .normalized();
+      const double tilt = std::pow(10.0, -2.0 - 10.0 * uniform(rng));
+      const Eigen::Quaterniond turned =
+          base *
+          Eigen::Quaterniond(Eigen::AngleAxisd(
+              tilt, Eigen::Vector3d(uniform(rng) - 0.5, uniform(rng) - 0.5, 0).normalized()));
+      const Eigen::Quaterniond flat_capsule =
+          base *
+          Eigen::Quaterniond(Eigen::AngleAxisd(6.3 * uniform(rng), Eigen::Vector3d::UnitZ())) *
+          Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()));
+      const Eigen::Quaterniond qa = pair == Pair::kPolygonPolygon ? turned : flat_capsule;
+      c.pose_a = Pose(c.pose_b.r() + base * Eigen::Vector3d(uniform(rng) - 0.5, uniform(rng) - 0.5,
+                                                            (uniform(rng) - 0.5) * tilt),
+                      Eigen::Vector4d(qa.w(), qa.x(), qa.y(), qa.z()));
+      const SignedDistance sd = signed_distance(c.a.shape, c.pose_a, c.b.shape, c.pose_b);
+      if (!sd.penetrating) continue;
+      ++penetrating;
+      const WorldCore wa = to_world(c.a, c.pose_a), wb = to_world(c.b, c.pose_b);
+      const double off = static_cast<double>(std::max(distance_to_core(sd.core_points[0], wa),
+                                                      distance_to_core(sd.core_points[1], wb)));
+      worst_off = std::max(worst_off, off);
+      ASSERT_LE(off, 1e-12) << name(pair) << " case " << i;
+      // (Cores within the tolerance, 1e-12 of the scene, keep their closest points: 4e-12.)
+      ASSERT_LE((sd.points[1] - sd.points[0] - sd.distance * sd.normal).norm(), 4e-12)
+          << name(pair) << " case " << i;
+      const double depth = static_cast<double>(brute_force_penetration_depth(wa, wb));
+      const double error = std::abs(sd.distance + radius(c.a.shape) + radius(c.b.shape) + depth);
+      worst_depth = std::max(worst_depth, error);
+      ASSERT_LE(error, 4e-12) << name(pair) << " case " << i;  // ties: 1e-12 of a scene < 4
+    }
+    std::cout << "[nearly coplanar] " << name(pair) << ": " << penetrating
+              << " in penetration, witnesses off the cores by at most " << worst_off
+              << ", |depth - separating axes| at most " << worst_depth << "\n";
+    EXPECT_GT(penetrating, 1000);
   }
 }
 

@@ -1,16 +1,28 @@
-"""Untangles a heap of overlapping capsules and padded polygons by gradient descent through
-diffpills.torch, until every pair has phi >= 0, and draws the heap before and after.
+"""Untangles a 3-D heap of capsules and padded polygons whose cores cross each other, by gradient
+descent through diffpills.torch.signed_distance, until every pair is apart; and shows why the
+signed distance is the measure for it.
 
-The bodies lie flat on the plane z = 0 (capsules with their axis in the plane, polygons in it), so
-that the top view shows every overlap exactly. Each body's pose is (x, y, yaw); its quaternion
-q = [cos(yaw/2), 0, 0, sin(yaw/2)] is built in torch, so autograd carries the library's exact
-d phi / d q back to the yaw. The loss is the sum over pairs of relu(R1 + R2 + margin - d)^2 with
-d = sqrt(phi + (R1 + R2)^2) the cores' distance, minimized with Adam. One diffpills.torch.proximity call per pair of shape kinds handles all bodies of those kinds.
+The heap: 24 bodies (sticks, plates, hexagons, triangles) thrown into a box at random positions
+and attitudes, so that many cores cross: a stick through a plate, two plates through each other.
+Each body's pose is its position r and a quaternion q (any nonzero 4-vector: the library normalizes
+it, and its gradient includes that), both optimized by Adam on
 
-phi's gradient is zero while two cores intersect (the proximity is flat there), so the heap is
-dealt so that padding overlaps but cores do not; the descent then only pushes cores apart.
+    loss = sum over pairs of relu(margin - distance)^2,
+
+distance being the signed distance of the two padded shapes: the gap between their surfaces, or
+minus their penetration depth. One diffpills.torch.signed_distance call per pair of shape kinds
+handles all bodies of those kinds.
+
+The same descent is run a second time with the paper's proximity phi in place of the distance
+(through the cores' distance sqrt(phi + (R1 + R2)^2), whose gradient keeps a unit size as cores
+approach): where two cores cross, phi is -(R1 + R2)^2 with a zero gradient, so those pairs never
+move apart, and the script reports how many are left. The signed distance has a slope there.
 
     PYTHONPATH=build/python /usr/bin/python3 examples/python/untangle.py [out_folder]
+
+writes out_folder/untangle_before.png and untangle_after.png (two perspective views of the cores;
+red: a body that overlaps another) and exits 0 when the signed-distance descent separated every
+pair.
 """
 
 import itertools
@@ -35,147 +47,158 @@ def regular_polygon(sides, circumradius, radius):
 
 
 KINDS = [
-    diffpills.Capsule(1.0, 0.12),
-    diffpills.Capsule(0.5, 0.2),
-    regular_polygon(6, 0.35, 0.08),
-    regular_polygon(3, 0.4, 0.1),
-    regular_polygon(4, 0.3, 0.15),
+    diffpills.Capsule(1.0, 0.06),
+    diffpills.Capsule(0.6, 0.1),
+    regular_polygon(4, 0.45, 0.03),
+    regular_polygon(6, 0.35, 0.05),
+    regular_polygon(3, 0.4, 0.04),
 ]
+BODIES = 24
+HALF_WIDTH = 0.6  # the box the heap is thrown into
+MARGIN = 1e-3  # the descent aims for every distance >= MARGIN
+STEPS = 3000
 
 
-def yaw_quaternion(yaw):
-    zeros = torch.zeros_like(yaw)
-    return torch.stack([torch.cos(0.5 * yaw), zeros, zeros, torch.sin(0.5 * yaw)], dim=1)
-
-
-def pair_phi(kinds, xy, yaw):
-    """phi for every pair of bodies (i < j), grouped into one batch call per pair of kinds, and
-    each pair's sum of radii."""
-    n = len(kinds)
-    position = torch.cat([xy, torch.zeros(n, 1, dtype=xy.dtype)], dim=1)
-    q = yaw_quaternion(yaw)
-    pairs, values, radii = [], [], []
+def kind_pairs(kinds):
+    """The pairs of bodies (i < j) grouped by their kinds (ka <= kb), the first of each pair of kind
+    ka, as index tensors: one batch call per group."""
+    groups = []
     for ka, kb in itertools.combinations_with_replacement(range(len(KINDS)), 2):
         group = [
             (i, j) if kinds[i] == ka else (j, i)
-            for i, j in itertools.combinations(range(n), 2)
+            for i, j in itertools.combinations(range(len(kinds)), 2)
             if sorted((kinds[i], kinds[j])) == [ka, kb]
         ]
-        if not group:
-            continue
-        first = torch.tensor([i for i, _ in group])
-        second = torch.tensor([j for _, j in group])
-        phi = diffpills.torch.proximity(
-            KINDS[ka], position[first], q[first], KINDS[kb], position[second], q[second]
-        )
-        pairs += group
-        values.append(phi)
-        radii.append(torch.full((len(group),), KINDS[ka].radius + KINDS[kb].radius, dtype=phi.dtype))
-    return pairs, torch.cat(values), torch.cat(radii)
+        if group:
+            groups.append((ka, kb, torch.tensor([i for i, _ in group]), torch.tensor([j for _, j in group])))
+    return groups
 
 
-def deal_heap(rng, count, half_width):
-    """Random flat bodies in a square, each placed where its core crosses no earlier core."""
-    kinds, xy, yaw = [], [], []
-    while len(kinds) < count:
-        kind = int(rng.integers(len(KINDS)))
-        candidate_xy = rng.uniform(-half_width, half_width, 2)
-        candidate_yaw = rng.uniform(0, 2 * np.pi)
-        pose = diffpills.Pose([*candidate_xy, 0.0], yaw_quaternion(torch.tensor([candidate_yaw]))[0].numpy())
-        if all(
-            not diffpills.proximity(
-                KINDS[kind], pose, KINDS[k], diffpills.Pose([*p, 0.0], yaw_quaternion(torch.tensor([a]))[0].numpy())
-            ).cores_intersect
-            for k, p, a in zip(kinds, xy, yaw)
-        ):
-            kinds.append(kind)
-            xy.append(candidate_xy)
-            yaw.append(candidate_yaw)
-    return kinds, np.array(xy), np.array(yaw)
+def measure(groups, r, q, kind="signed_distance"):
+    """Every pair's signed distance (kind "signed_distance"), or its distance from phi as the cores'
+    distance sqrt(phi + (R1 + R2)^2) - R1 - R2 (kind "phi", flat where cores cross), in the order of
+    `groups`; and whether the pair's cores cross (their signed distance below -(R1 + R2))."""
+    values, crossing = [], []
+    for ka, kb, first, second in groups:
+        radii = KINDS[ka].radius + KINDS[kb].radius
+        signed = diffpills.torch.signed_distance(KINDS[ka], r[first], q[first], KINDS[kb], r[second], q[second])
+        crossing.append(signed.detach() < -radii)
+        if kind == "signed_distance":
+            values.append(signed)
+        else:
+            phi = diffpills.torch.proximity(KINDS[ka], r[first], q[first], KINDS[kb], r[second], q[second])
+            values.append(torch.sqrt(torch.clamp(phi + radii**2, min=0.0) + 1e-30) - radii)
+    return torch.cat(values), torch.cat(crossing)
 
 
-def silhouette(shape, x, y, yaw):
-    """Top-view outline of a flat padded shape: the convex hull of circles of its radius around
-    its core's vertices (exact for a convex core), as a closed polygon."""
+def deal_heap(rng):
+    kinds = rng.integers(len(KINDS), size=BODIES)
+    r = rng.uniform(-HALF_WIDTH, HALF_WIDTH, (BODIES, 3))
+    q = rng.normal(size=(BODIES, 4))
+    return list(kinds), r, q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def descend(groups, r0, q0, kind):
+    """Adam on the poses until every pair's distance (of `kind`) is >= 0, or STEPS steps."""
+    r = torch.tensor(r0, requires_grad=True)
+    q = torch.tensor(q0, requires_grad=True)
+    optimizer = torch.optim.Adam([r, q], lr=0.005)
+    for step in range(STEPS):
+        optimizer.zero_grad()
+        distance, _ = measure(groups, r, q, kind)
+        if distance.min().item() >= 0.0:
+            break
+        torch.relu(MARGIN - distance).pow(2).sum().backward()
+        optimizer.step()
+    with torch.no_grad():
+        distance, crossing = measure(groups, r, q)  # judged by the signed distance in both runs
+    return r.detach().numpy(), q.detach().numpy(), distance.numpy(), crossing.numpy(), step
+
+
+def rotation(q):
+    w, x, y, z = q / np.linalg.norm(q)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def core_vertices(shape, r, q):
+    """The core's vertices in the world: a segment's two ends, a polygon's corners."""
     if isinstance(shape, diffpills.Capsule):
-        core = np.array([[-0.5 * shape.length, 0.0], [0.5 * shape.length, 0.0]])
+        body = np.array([[-0.5 * shape.length, 0.0, 0.0], [0.5 * shape.length, 0.0, 0.0]])
     else:
-        core = shape.vertices
-    c, s = np.cos(yaw), np.sin(yaw)
-    core = core @ np.array([[c, s], [-s, c]]) + [x, y]
-    circle = np.linspace(0, 2 * np.pi, 48, endpoint=False)
-    ring = shape.radius * np.stack([np.cos(circle), np.sin(circle)], axis=1)
-    points = (core[:, None, :] + ring[None, :, :]).reshape(-1, 2) if shape.radius > 0 else core
-    return convex_hull(points)
+        body = np.hstack([shape.vertices, np.zeros((len(shape.vertices), 1))])
+    return body @ rotation(q).T + r
 
 
-def convex_hull(points):
-    """Andrew's monotone chain, counterclockwise."""
-    points = sorted(map(tuple, points))
-
-    def half(sequence):
-        chain = []
-        for p in sequence:
-            while len(chain) >= 2 and np.cross(np.subtract(chain[-1], chain[-2]), np.subtract(p, chain[-2])) <= 0:
-                chain.pop()
-            chain.append(p)
-        return chain[:-1]
-
-    return np.array(half(points) + half(reversed(points)))
+VIEWS = [(25, -60), (25, 30)]  # (elevation, azimuth) of the two perspective views, degrees
 
 
-def draw(path, title, kinds, xy, yaw, phi, pairs):
-    overlapping = {i for (i, j), value in zip(pairs, phi) if value < 0} | {
-        j for (i, j), value in zip(pairs, phi) if value < 0
-    }
-    figure, axes = plt.subplots(figsize=(6, 6))
-    for index, (kind, (x, y), angle) in enumerate(zip(kinds, xy, yaw)):
-        outline = silhouette(KINDS[kind], x, y, angle)
-        color = "#d62728" if index in overlapping else "#2ca02c"
-        axes.fill(outline[:, 0], outline[:, 1], color=color, alpha=0.35, linewidth=1.0, edgecolor=color)
-    axes.set_aspect("equal")
-    axes.set_xlim(-2.6, 2.6)
-    axes.set_ylim(-2.6, 2.6)
-    axes.set_title(f"{title}: {len(overlapping)} of {len(kinds)} bodies overlap, min phi {min(phi):.3g}")
-    axes.set_xlabel("x")
-    axes.set_ylabel("y")
+def draw(path, title, kinds, r, q, groups, distance):
+    """Two perspective views of the cores (polygons filled, capsules as tubes of their radius);
+    red: a body that overlaps another."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    pairs = [(int(i), int(j)) for _, _, first, second in groups for i, j in zip(first, second)]
+    overlapping = {body for pair, value in zip(pairs, distance) if value < 0 for body in pair}
+    figure = plt.figure(figsize=(12, 6))
+    for index, (elevation, azimuth) in enumerate(VIEWS):
+        ax = figure.add_subplot(1, 2, index + 1, projection="3d")
+        for body, kind in enumerate(kinds):
+            shape = KINDS[kind]
+            color = "#d62728" if body in overlapping else "#2ca02c"
+            points = core_vertices(shape, r[body], q[body])
+            if isinstance(shape, diffpills.Capsule):
+                # A tube's width in points: the radius over the axes' span, times the figure's width.
+                ax.plot(*points.T, color=color, linewidth=260 * shape.radius, solid_capstyle="round", alpha=0.8)
+            else:
+                ax.add_collection3d(Poly3DCollection([points], facecolor=color, edgecolor=color, alpha=0.45))
+        for set_limits in (ax.set_xlim, ax.set_ylim, ax.set_zlim):
+            set_limits(-1.1, 1.1)
+        ax.set_box_aspect((1, 1, 1))
+        ax.view_init(elevation, azimuth)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_zlabel("z")
+    figure.suptitle(title)
     figure.tight_layout()
-    figure.savefig(path, dpi=110)
+    figure.savefig(path, dpi=90)
     plt.close(figure)
+
+
+def summary(distance, crossing):
+    return (
+        f"{int((distance < 0).sum())} overlapping pairs ({int(crossing.sum())} with crossing cores), "
+        f"smallest signed distance {distance.min():.3g}"
+    )
 
 
 def main(out_folder):
     out = pathlib.Path(out_folder)
     out.mkdir(parents=True, exist_ok=True)
-    rng = np.random.default_rng(4)
-    kinds, xy0, yaw0 = deal_heap(rng, count=24, half_width=1.6)
-    xy = torch.tensor(xy0, requires_grad=True)
-    yaw = torch.tensor(yaw0, requires_grad=True)
-    pairs, phi, _ = pair_phi(kinds, xy, yaw)
-    before = phi.detach().numpy()
-    draw(out / "untangle_before.png", "before", kinds, xy0, yaw0, before, pairs)
+    torch.manual_seed(0)
+    kinds, r0, q0 = deal_heap(np.random.default_rng(7))
+    groups = kind_pairs(kinds)
+    with torch.no_grad():
+        before, crossing_before = (v.numpy() for v in measure(groups, torch.tensor(r0), torch.tensor(q0)))
+    draw(out / "untangle_before.png", f"before: {summary(before, crossing_before)}", kinds, r0, q0, groups, before)
 
-    optimizer = torch.optim.Adam([xy, yaw], lr=0.01)
-    margin = 1e-3
-    for step in range(5000):
-        optimizer.zero_grad()
-        pairs, phi, radii = pair_phi(kinds, xy, yaw)
-        if phi.min().item() >= 0.0:
-            break
-        # The cores' distance d = sqrt(phi + (R1 + R2)^2): its gradient keeps unit size as the
-        # cores approach, where phi's own gradient 2 d n fades, so jammed bodies keep separating.
-        distance = torch.sqrt(torch.clamp(phi + radii**2, min=1e-12))
-        loss = torch.relu(radii + margin - distance).pow(2).sum()
-        loss.backward()
-        optimizer.step()
-    after = phi.detach().numpy()
-    draw(out / "untangle_after.png", "after", kinds, xy.detach().numpy(), yaw.detach().numpy(), after, pairs)
-    print(
-        f"untangle: {len(kinds)} bodies, {len(pairs)} pairs; overlapping pairs {int((before < 0).sum())} -> "
-        f"{int((after < 0).sum())} in {step} steps, min phi {before.min():.3g} -> {after.min():.3g}; "
-        f"figures {out / 'untangle_before.png'}, {out / 'untangle_after.png'}"
+    _, _, after_phi, crossing_phi, steps_phi = descend(groups, r0, q0, "phi")
+    r, q, after, crossing, steps = descend(groups, r0, q0, "signed_distance")
+    draw(
+        out / "untangle_after.png",
+        f"after {steps} steps on the signed distance: {summary(after, crossing)}",
+        kinds, r, q, groups, after,
     )
-    return 0 if after.min() >= 0.0 else 1
+    print(f"untangle: {BODIES} bodies, {len(before)} pairs; before: {summary(before, crossing_before)}")
+    print(f"  signed distance: after {steps} steps, {summary(after, crossing)}")
+    print(f"  phi:             after {steps_phi} steps, {summary(after_phi, crossing_phi)} (flat where cores cross)")
+    print(f"  figures {out / 'untangle_before.png'}, {out / 'untangle_after.png'}")
+    return 0 if after.min() >= 0.0 and crossing_before.sum() > 0 else 1
 
 
 if __name__ == "__main__":

@@ -43,17 +43,17 @@
 //   - Penetrating facets that tie (a capsule through a polygon's centre, equally deep both ways)
 //     are decided by the same rule; the normal then jumps as the configuration leaves the tie,
 //     and the gradient is that of the chosen facet (one-sided).
-//   - Known limitation (open, issue 10): where cores cross nearly coplanar (within ~1e-4 rad, as
-//     fuzzing found), facets a tolerance apart in depth can lie far apart along D, and the
-//     chosen facet's witnesses may not split its nearest point. The closest points (the middle
-//     of the cores' intersection) then stand in: distance, normal and gradient are still those
-//     of the facet, but points[1] - points[0] = distance * normal holds only to the depth.
+//   - Cores crossing nearly coplanar: D is thin, and facets within the tolerance of the nearest
+//     one in depth can lie far apart along it. Only a facet whose nearest point lies on it is
+//     taken, so the witnesses always lie on the two cores (penetration.hpp).
 //   - Tolerances are relative (1e-12 of the scene's size), as for proximity(), and every input
 //     proximity() accepts is answered at every magnitude; scaling all lengths by 2^k scales
 //     distance and the points by 2^k, the gradient's quaternion part by 2^k, exactly.
 //
-// Cost: that of proximity() apart; in penetration O(m) for a capsule and an m-gon and O(m1 m2) for
-// two polygons (their D has that many facets). Nothing is allocated up to 32 vertices.
+// Cost: that of proximity() apart; in penetration O(m) for a capsule and an m-gon. Two polygons
+// have m1 m2 edge-pair facets; up to 32 x 32 vertices each pair is visited (nothing is allocated),
+// above, a search of bounding hierarchies over the two polygons' edge chains visits only the pairs
+// that can hold the nearest facet, about O((m1 + m2) log): two crossing 10^5-gons take ~15 ms.
 #pragma once
 
 #include <Eigen/Core>

@@ -65,8 +65,28 @@ Eigen::Index intersect(SmallBuffer<HalfPlane, 72>& planes, SmallBuffer<Eigen::Ve
     }
     deque[tail++] = h;
   }
-  while (tail - head >= 3 && outside(deque[head], meet(deque[tail - 2], deque[tail - 1]))) --tail;
-  while (tail - head >= 3 && outside(deque[tail - 1], meet(deque[head], deque[head + 1]))) ++head;
+  // Closing the loop: rows within 1e-12 of one direction can sit at both ends of the deque, one
+  // just below the angle 2 pi and one at 0 (two polygons' rows of one direction, one of them
+  // turned by -1e-158: found by fuzz_proximity, which got an empty overlap of parallel polygons in
+  // one order of the shapes only); the tighter binds, as above. Then the ends' corners outside the
+  // other end's row are dropped.
+  while (tail - head >= 2) {
+    const HalfPlane& last = deque[tail - 1];
+    const HalfPlane& first = deque[head];
+    if (parallel(last, first) && last.normal.dot(first.normal) > 0.0) {
+      if (last.offset >= first.offset) {
+        --tail;
+      } else {
+        ++head;
+      }
+    } else if (tail - head >= 3 && outside(first, meet(deque[tail - 2], last))) {
+      --tail;
+    } else if (tail - head >= 3 && outside(last, meet(first, deque[head + 1]))) {
+      ++head;
+    } else {
+      break;
+    }
+  }
   if (tail - head < 3) return 0;
   Eigen::Index count = 0;
   for (Eigen::Index i = head; i < tail; ++i) {

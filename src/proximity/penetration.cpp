@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
+#include "edge_chain_tree.hpp"
 #include "segment_segment.hpp"
 
 namespace diffpills::detail {
@@ -15,16 +17,13 @@ namespace {
 constexpr double kParallelSine = 1e-12;
 // The normal-cone tests' allowance, a cosine (see the header).
 constexpr double kConeSlack = 1e-12;
-// An edge pair whose normal is within this angle of a polygon's face normal is left to the face.
-constexpr double kSliverAngle = 1e-10;
+// How far (relatively) an edge pair's witnesses may be further apart than its facet's depth (the
+// header's witness rule).
+constexpr double kWitnessRatio = 1e-9;
+// Polygon pairs with more edge pairs than this (32 x 32) search the edge chains' hierarchies.
+constexpr Eigen::Index kEnumeratedEdgePairs = Eigen::Index{32} * 32;
 
-// Is n within kSliverAngle of +-(the face normal of `core`)? Such an edge-pair facet is a sliver
-// beside the face's facet (their normals' arcs meet at the face's pole), whose nearest point a
-// rounding moves off it (fuzz_proximity found its witnesses a third of the scene apart). Leaving
-// it out changes the depth by at most the angle times D's reach: 1e-10 of the scene.
-bool along_a_face(const Eigen::Vector3d& n, const CoreOutline& core) {
-  return core.is_polygon() && n.cross(core.face_normal()).norm() <= kSliverAngle;
-}
+using Sides = std::array<ClosestFeature, 2>;
 
 // The header's order of candidates: smaller depth, then a face over an edge pair, then larger
 // n . (r2 - r1), then larger n . (Q1 e_z), each compared with the tolerance so that rounding does
@@ -43,9 +42,10 @@ bool better(const DeepestFacet& candidate, const DeepestFacet& best, const Eigen
 // A face facet: `face` (core face_core) is a whole polygon, `other` touches the facet with its
 // support set, the vertices within the tolerance of other's extreme value along -sign * n, with
 // sign = +1 for core 1's face (K2's lowest points) and -1 for core 2's (K1's highest points).
-// The pair is x_face = x_other + sign * depth * n.
-std::array<ClosestFeature, 2> face_witnesses(const DeepestFacet& facet, const CoreOutline& face,
-                                             const CoreOutline& other, double tolerance) {
+// The pair is x_face = x_other + sign * depth * n, with x_face in the face (to the tolerance);
+// none when the support set's shadow misses the face (the facet's nearest point is off it).
+std::optional<Sides> face_witnesses(const DeepestFacet& facet, const CoreOutline& face,
+                                    const CoreOutline& other, double tolerance) {
   const double sign = facet.face_core == 0 ? 1.0 : -1.0;
   const Eigen::Vector3d shift = sign * facet.depth * facet.normal;
   const Eigen::Vector3d down = -sign * facet.normal;  // other's support direction
@@ -59,8 +59,7 @@ std::array<ClosestFeature, 2> face_witnesses(const DeepestFacet& facet, const Co
     }
   }
   const auto ordered = [&](const ClosestFeature& face_side, const ClosestFeature& other_side) {
-    return facet.face_core == 0 ? std::array<ClosestFeature, 2>{face_side, other_side}
-                                : std::array<ClosestFeature, 2>{other_side, face_side};
+    return facet.face_core == 0 ? Sides{face_side, other_side} : Sides{other_side, face_side};
   };
   const auto body = [&](const Eigen::Vector3d& x) -> Eigen::Vector2d {
     return (face.posed().attitude.matrix().transpose() * (x - face.posed().r)).head<2>();
@@ -84,32 +83,172 @@ std::array<ClosestFeature, 2> face_witnesses(const DeepestFacet& facet, const Co
     }
   }
   // A vertex: the first support vertex whose shadow lies on the face (the only one, unless a
-  // face of `other` is parallel to this one, where D is flat and the caller does not ask).
-  Eigen::Index chosen = first;
+  // face of `other` is parallel to this one, where D is flat and no witnesses are asked for).
   for (Eigen::Index i = first; i <= last; ++i) {
     if (down.dot(other.vertex(i)) >= extreme - tolerance &&
         contains(face.polygon(), body(other.vertex(i) + shift), tolerance)) {
-      chosen = i;
-      break;
+      return ordered(face.face_side(other.vertex(i) + shift), other.vertex_side(i));
     }
   }
-  return ordered(face.face_side(other.vertex(chosen) + shift), other.vertex_side(chosen));
+  return std::nullopt;
 }
 
 // An edge-edge facet: the points of the two edges whose difference is along n, the closest points
-// of the edges' lines, which lie on the edges for the nearest facet. They are taken from the
-// backward-stable segment solver (segment_segment.hpp), not from the normal: for nearly parallel
-// edges (angle alpha) the normal e x f / |e x f| is only known to ~1e-16 / alpha, while the closest
-// points are accurate; the caller then takes the normal from them.
-std::array<ClosestFeature, 2> edge_witnesses(const DeepestFacet& facet, const CoreOutline& a,
-                                             const CoreOutline& b) {
+// of the edges' lines, which lie on the edges when the facet's nearest point lies on it. They are
+// taken from the backward-stable segment solver (segment_segment.hpp), not from the normal: for
+// nearly parallel edges (angle alpha) the normal e x f / |e x f| is only known to ~1e-16 / alpha,
+// while the closest points are accurate. x1 - x2 is a point of the facet (which lies in D's
+// boundary), so |x1 - x2| is at least the depth; it is accepted when it points along n and is at
+// most the facet's value (known to within `uncertainty`) times 1 + kWitnessRatio plus the
+// tolerance, and the facet's depth and normal are then taken from it.
+bool take_edge_witnesses(DeepestFacet& facet, double uncertainty, const CoreOutline& a,
+                         const CoreOutline& b, double tolerance) {
   const OutlineEdge& e = a.edge(facet.edges[0]);
   const OutlineEdge& f = b.edge(facet.edges[1]);
-  const SegmentParameters closest =
-      closest_segment_parameters({e.start + 0.5 * e.length * e.direction, e.direction, e.length},
-                                 {f.start + 0.5 * f.length * f.direction, f.direction, f.length});
-  return {a.edge_side(facet.edges[0], closest.s), b.edge_side(facet.edges[1], closest.t)};
+  const Segment edge_e{e.start + 0.5 * e.length * e.direction, e.direction, e.length};
+  const Segment edge_f{f.start + 0.5 * f.length * f.direction, f.direction, f.length};
+  const SegmentParameters closest = closest_segment_parameters(edge_e, edge_f);
+  const Eigen::Vector3d across = edge_e.at(closest.s_offset) - edge_f.at(closest.t_offset);
+  const double depth = across.norm();
+  if (depth <= tolerance || across.dot(facet.normal) <= 0.0 ||
+      depth > (facet.depth + uncertainty) * (1.0 + kWitnessRatio) + tolerance) {
+    return false;
+  }
+  facet.depth = depth;
+  facet.normal = across / depth;
+  facet.witnesses =
+      Sides{a.edge_side(facet.edges[0], closest.s), b.edge_side(facet.edges[1], closest.t)};
+  return true;
 }
+
+// The search keeps the best candidate whose witnesses lie on its facet (`best`, in the header's
+// order, with its depth from the witnesses), the candidate of smallest value (`lowest`, the
+// fallback) and an upper bound on the depth: the smallest value plus its rounding error (a
+// candidate's value is h_D at its normal, at least the depth up to that error).
+//
+// A candidate's value carries the error of its normal: an edge pair's normal is off by ~2 ulps of
+// the edges' directions over their sine, so its value by that times |x_e - x_f|; a face's normal
+// is exact to a few ulps. An edge pair admitted by the normal-cone allowance adds what that
+// allowance can hide (below).
+class FacetSearch final : public NearNormalEdgePairs {
+ public:
+  FacetSearch(const CoreOutline& a, const CoreOutline& b, double tolerance)
+      : a_(a),
+        b_(b),
+        tolerance_(tolerance),
+        offset_(b.posed().r - a.posed().r),
+        z1_(a.face_normal()) {}
+
+  void consider_faces() {
+    for (int core = 0; core < 2; ++core) {
+      const CoreOutline& face = core == 0 ? a_ : b_;
+      if (!face.is_polygon()) continue;
+      for (const double sign : {1.0, -1.0}) {
+        const Eigen::Vector3d n = sign * face.face_normal();
+        DeepestFacet candidate;
+        candidate.kind = DeepestFacet::Kind::kFace;
+        candidate.depth = a_.support(n) + b_.support(-n);
+        candidate.normal = n;
+        candidate.face_core = core;
+        offer(candidate, kValueRounding);
+      }
+    }
+  }
+
+  void consider_edges(Eigen::Index i, Eigen::Index j) {
+    const OutlineEdge& e = a_.edge(i);
+    const OutlineEdge& f = b_.edge(j);
+    const Eigen::Vector3d c = stable_cross(e.direction, f.direction);
+    const double sine = c.norm();
+    if (sine <= kParallelSine) return;
+    const Eigen::Vector3d n = c / sine;
+    const Eigen::Vector3d between = e.start - f.start;
+    const double gap = n.dot(between);
+    const double rounding = kValueRounding * (1.0 + between.norm() / sine);
+    for (const double sign : {1.0, -1.0}) {
+      // How far n leans out of each edge's normal cone (zero for a segment, whose cone is every
+      // normal), at most the allowance.
+      const double out_a = a_.is_polygon() ? std::max(0.0, -sign * n.dot(e.outward)) : 0.0;
+      const double out_b = b_.is_polygon() ? std::max(0.0, sign * n.dot(f.outward)) : 0.0;
+      if (out_a > kConeSlack || out_b > kConeSlack) continue;
+      DeepestFacet candidate;
+      candidate.kind = DeepestFacet::Kind::kEdges;
+      candidate.depth = sign * gap;
+      candidate.normal = sign * n;
+      candidate.edges = {i, j};
+      // Admitted out of a cone by `out`, the edge is short of that core's support along n by at
+      // most out times the core's diameter (2 size): the value may be that much below h_D(n).
+      offer(candidate, rounding + 2.0 * (out_a * a_.posed().size + out_b * b_.posed().size));
+    }
+  }
+
+  DeepestFacet result() const {
+    if (best_.kind != DeepestFacet::Kind::kNone && best_.depth <= reach()) return best_;
+    DeepestFacet fallback = lowest_;
+    if (fallback.kind == DeepestFacet::Kind::kNone) fallback.depth = 0.0;
+    return fallback;
+  }
+
+  // NearNormalEdgePairs. A pair's witnessed depth is |x1 - x2|, which must be at most limit() to
+  // count. For the nearest facet x1 - x2 = depth * n is normal to both edges up to rounding; a
+  // facet tied with it (depth within the tolerance) leans off its normal by at most
+  // sqrt(|x1 - x2|^2 - value^2) <= sqrt(limit^2 - (limit - 2 tolerance)^2), and is kept too
+  // (unless its value is uncertain, nearly parallel edges: ties may then be broken otherwise
+  // than by visiting every pair).
+  double distance_bound() const override { return limit() + kRounding; }
+  double normal_slack() const override {
+    const double bound = std::max(limit(), 0.0);
+    const double low = std::max(bound - 2.0 * tolerance_, 0.0);
+    return std::sqrt(bound * bound - low * low) + kRounding;
+  }
+  void visit(Eigen::Index edge_a, Eigen::Index edge_b) override { consider_edges(edge_a, edge_b); }
+
+ private:
+  // Witnessed depths are taken up to this: the bound on the depth plus what a witnessed depth may
+  // exceed the value by.
+  double reach() const { return depth_bound_ * (1.0 + kWitnessRatio) + tolerance_; }
+  // A candidate counts only if its depth is at most this (it must tie with or beat `best`).
+  double limit() const {
+    return best_.kind == DeepestFacet::Kind::kNone ? reach()
+                                                   : std::min(reach(), best_.depth + tolerance_);
+  }
+
+  void offer(DeepestFacet candidate, double uncertainty) {
+    if (lowest_.kind == DeepestFacet::Kind::kNone ||
+        better(candidate, lowest_, offset_, z1_, tolerance_)) {
+      lowest_ = candidate;
+    }
+    depth_bound_ = std::min(depth_bound_, candidate.depth + uncertainty);
+    if (candidate.depth - uncertainty > limit()) return;
+    if (candidate.depth > tolerance_ && !take_witnesses(candidate, uncertainty)) return;
+    if (best_.kind == DeepestFacet::Kind::kNone ||
+        better(candidate, best_, offset_, z1_, tolerance_)) {
+      best_ = candidate;
+    }
+  }
+
+  bool take_witnesses(DeepestFacet& candidate, double uncertainty) const {
+    if (candidate.kind == DeepestFacet::Kind::kEdges) {
+      return take_edge_witnesses(candidate, uncertainty, a_, b_, tolerance_);
+    }
+    candidate.witnesses = candidate.face_core == 0 ? face_witnesses(candidate, a_, b_, tolerance_)
+                                                   : face_witnesses(candidate, b_, a_, tolerance_);
+    return candidate.witnesses.has_value();
+  }
+
+  // In the frame's units (the scene's size in [1, 2)): a value's rounding, a few ulps of the
+  // scene; and how far the edge-pair search's bounds are kept above what they bound, far above
+  // the rounding of the sums that form them.
+  static constexpr double kValueRounding = 1e-15;
+  static constexpr double kRounding = 1e-12;
+
+  const CoreOutline& a_;
+  const CoreOutline& b_;
+  double tolerance_;
+  Eigen::Vector3d offset_, z1_;
+  DeepestFacet lowest_, best_;
+  double depth_bound_ = std::numeric_limits<double>::infinity();
+};
 
 }  // namespace
 
@@ -117,50 +256,20 @@ Eigen::Vector3d stable_cross(const Eigen::Vector3d& e, const Eigen::Vector3d& f)
   return e.cross(e.dot(f) >= 0.0 ? Eigen::Vector3d(f - e) : Eigen::Vector3d(f + e));
 }
 
-DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double tolerance) {
-  const Eigen::Vector3d offset = b.posed().r - a.posed().r;
-  const Eigen::Vector3d z1 = a.face_normal();
-  DeepestFacet best;
-  best.depth = std::numeric_limits<double>::infinity();
-  const auto consider = [&](const DeepestFacet& candidate) {
-    if (best.kind == DeepestFacet::Kind::kNone || better(candidate, best, offset, z1, tolerance)) {
-      best = candidate;
-    }
-  };
-  for (int core = 0; core < 2; ++core) {
-    const CoreOutline& face = core == 0 ? a : b;
-    if (!face.is_polygon()) continue;
-    for (const double sign : {1.0, -1.0}) {
-      const Eigen::Vector3d n = sign * face.face_normal();
-      consider({DeepestFacet::Kind::kFace, a.support(n) + b.support(-n), n, core, {0, 0}});
+DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double tolerance,
+                           EdgePairVisits visits) {
+  FacetSearch search(a, b, tolerance);
+  search.consider_faces();
+  if (visits == EdgePairVisits::kPruned && a.is_polygon() && b.is_polygon() &&
+      a.edge_count() * b.edge_count() > kEnumeratedEdgePairs) {
+    const EdgeChainTree tree_a(a), tree_b(b);
+    search_near_normal_edge_pairs(tree_a, tree_b, search);
+  } else {
+    for (Eigen::Index i = 0; i < a.edge_count(); ++i) {
+      for (Eigen::Index j = 0; j < b.edge_count(); ++j) search.consider_edges(i, j);
     }
   }
-  for (Eigen::Index i = 0; i < a.edge_count(); ++i) {
-    const OutlineEdge& e = a.edge(i);
-    for (Eigen::Index j = 0; j < b.edge_count(); ++j) {
-      const OutlineEdge& f = b.edge(j);
-      const Eigen::Vector3d c = stable_cross(e.direction, f.direction);
-      const double sine = c.norm();
-      if (sine <= kParallelSine) continue;
-      const Eigen::Vector3d n = c / sine;
-      if (along_a_face(n, a) || along_a_face(n, b)) continue;
-      const double gap = n.dot(e.start - f.start);
-      for (const double sign : {1.0, -1.0}) {
-        if (a.is_polygon() && sign * n.dot(e.outward) < -kConeSlack) continue;
-        if (b.is_polygon() && sign * n.dot(f.outward) > kConeSlack) continue;
-        consider({DeepestFacet::Kind::kEdges, sign * gap, sign * n, 0, {i, j}});
-      }
-    }
-  }
-  if (best.kind == DeepestFacet::Kind::kNone) best.depth = 0.0;
-  return best;
-}
-
-std::array<ClosestFeature, 2> facet_witnesses(const DeepestFacet& facet, const CoreOutline& a,
-                                              const CoreOutline& b, double tolerance) {
-  if (facet.kind == DeepestFacet::Kind::kEdges) return edge_witnesses(facet, a, b);
-  return facet.face_core == 0 ? face_witnesses(facet, a, b, tolerance)
-                              : face_witnesses(facet, b, a, tolerance);
+  return search.result();
 }
 
 }  // namespace diffpills::detail

@@ -19,16 +19,31 @@
 //     K1 needs n . o >= 0 and an edge of K2 (mirrored in -K2) n . o <= 0; a segment, which is
 //     its own edge, admits every n normal to it. Such a facet's h_D(n) = n . (x_e - x_f) for any
 //     points x_e, x_f of the two edges: the distance between the edges' lines.
-// A vertex plus a vertex or an edge is not 2-D, so there are no other facets. Edge pairs whose
-// normal lies within 1e-10 rad of a polygon's face normal are slivers beside that face's facet,
-// left to it (the depth moves by at most 1e-10 of the scene's size; their witnesses are not well
-// defined), as are edge pairs within |sin| <= 1e-12 of parallel (by at most 1e-12). Every
-// candidate's value is h_D at a facet normal, at least the depth, and the nearest facet is among
-// them: their minimum is the depth. The normal-cone tests allow 1e-12 (a cosine, so relative): a
-// candidate admitted within it is below the true h_D(n) by at most 1e-12 of the scene's size.
+// A vertex plus a vertex or an edge is not 2-D, so there are no other facets. Edge pairs within
+// |sin| <= 1e-12 of parallel are left out (the depth moves by at most 1e-12 of the scene's size).
+// Every candidate's value is h_D at a facet normal, at least the depth, and the nearest facet is
+// among them: their minimum is the depth. The normal-cone tests allow 1e-12 (a cosine, so
+// relative): a candidate admitted within it is below the true h_D(n) by at most 1e-12 of the
+// scene's size.
 //
 // Where D is flat (two segments, a segment lying in a polygon's plane, coplanar polygons) it has
 // no interior; the candidates +-n of its plane then both give 0, the documented depth.
+//
+// Witnesses. The nearest facet's nearest point lies on it: x1 - x2 = depth * n with x1, x2 in the
+// facet's two features (a face's polygon and the other core's support vertex or edge shifted onto
+// it; or the two edges, at the feet of their common normal). So only facets whose nearest point
+// lies on them (to the tolerance) are candidates: their minimum is still the depth, and the chosen
+// facet always has witnesses that split its nearest point on both cores. (Where cores cross
+// nearly coplanar, D is thin and facets a tolerance apart in depth can lie far apart along it;
+// choosing among all facets, the tie-break could take one whose nearest point was off it, and its
+// witnesses then lay off the cores by up to the scene's size.) An edge pair's witnesses are the
+// closest points of the two edges from the backward-stable segment solver: x1 - x2 is a point of
+// the facet, so of D's boundary, and |x1 - x2| >= depth. It is accepted when it points along n and
+// |x1 - x2| <= (value + its rounding error) (1 + 1e-9) + tolerance, and the facet's depth and
+// normal are then taken from it: accurate also where the edges are nearly parallel and e x f is
+// not. Should no candidate's witnesses pass within 1e-9 of the smallest value (never seen; it
+// would take rounding to move the nearest facet's point off it), that value stands with no
+// witnesses, and the caller uses the closest points.
 //
 // Ties (values within the frame's tolerance) go to a polygon's face over an edge pair (a face's
 // witnesses are well conditioned; an edge pair's nearly parallel to the face makes a sliver facet
@@ -37,12 +52,15 @@
 // and flips with the order of the shapes; then to the one most along core 1's Q e_z; then to the
 // first found (faces of core 1, faces of core 2, edge pairs in order).
 //
-// Cost: O(m1 m2) for two polygons of m1 and m2 vertices (D has that many edge-edge facets),
-// O(m) for a segment and a polygon; nothing is allocated up to 32 vertices.
+// Cost: O(m) for a segment and a polygon of m vertices; two polygons of up to 32 x 32 vertex pairs
+// have every edge pair visited (nothing is allocated); larger pairs search bounding hierarchies of
+// their edge chains (edge_chain_tree.hpp) for the edge pairs that can hold a facet's nearest point
+// within the depth found so far, about O((m1 + m2) log) instead of the m1 m2 facets D has.
 #pragma once
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 
 #include "core_outline.hpp"
 
@@ -59,9 +77,19 @@ struct DeepestFacet {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, outward from D: from core 1 to core 2
   int face_core = 0;
   std::array<Eigen::Index, 2> edges = {0, 0};
+  // The points x1 of core 1 and x2 of core 2 on the facet with x1 - x2 = depth * normal: its
+  // nearest point split into the two cores (the middle of the set of such pairs when it is not
+  // one pair: the middle of an edge's part over a face). Unset where the depth is within the
+  // tolerance (touching, or a flat D: the closest points serve) and in the header's fallback.
+  std::optional<std::array<ClosestFeature, 2>> witnesses;
 };
 
-DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double tolerance);
+// Which edge pairs the search visits: those the edge chains' hierarchies leave (the default: every
+// pair up to 32 x 32), or every pair (for tests of the hierarchies).
+enum class EdgePairVisits { kPruned, kEvery };
+
+DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double tolerance,
+                           EdgePairVisits visits = EdgePairVisits::kPruned);
 
 // e x f for unit vectors e and f, computed as e x (f - e) (or e x (f + e) when they point apart):
 // the same vector, but for nearly parallel e and f the difference f - e is exact and the product
@@ -69,11 +97,5 @@ DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double to
 // direction (fuzz_proximity: two polygons crossing at 2e-11 rad got a facet normal 1e-5 off and
 // a depth of the polygons' size instead of 2e-11 of it).
 Eigen::Vector3d stable_cross(const Eigen::Vector3d& e, const Eigen::Vector3d& f);
-
-// Points x1 of core 1 and x2 of core 2 on the facet with x1 - x2 = depth * normal: the point of
-// D's facet nearest the origin, split into its two cores (the middle of the set of such pairs
-// when it is not one pair: the middle of an edge's part over a face). Only for kFace and kEdges.
-std::array<ClosestFeature, 2> facet_witnesses(const DeepestFacet& facet, const CoreOutline& a,
-                                              const CoreOutline& b, double tolerance);
 
 }  // namespace diffpills::detail

@@ -28,10 +28,6 @@ using detail::PolygonView;
 using detail::PosedCore;
 using detail::SignedSolution;
 
-// How far the witnesses x1 - x2 may be from depth * normal, in the frame's units (where the scene's
-// size is in [1, 2)): a few thousand roundings.
-constexpr double kWitnessSlack = 1e-12;
-
 // The normal where D has no facet (parallel segments, spheres): see signed_distance.hpp. `axis`
 // is the segments' common direction, or zero for two spheres.
 Eigen::Vector3d fallback_normal(const CoreOutline& a, const CoreOutline& b, double tolerance) {
@@ -113,27 +109,9 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   }
   solution.gap = -facet.depth;
   solution.normal = facet.normal;
-  if (facet.depth <= frame.tolerance) return solution;  // touching, or a flat D: as they are
-  const detail::Sides witnesses =
-      detail::facet_witnesses(facet, outline_a, outline_b, frame.tolerance);
-  const Eigen::Vector3d across = pa.r + pa.attitude.matrix() * witnesses[0].body_point - pb.r -
-                                 pb.attitude.matrix() * witnesses[1].body_point;
-  const double depth = across.norm();
-  if (facet.kind == DeepestFacet::Kind::kEdges && depth > frame.tolerance &&
-      across.dot(facet.normal) > 0.0 && depth <= facet.depth * (1.0 + 1e-9) + frame.tolerance) {
-    // Depth and normal from the witnesses x1 - x2 = depth * n, which are accurate also where the
-    // edges are nearly parallel and e x f is not (penetration.hpp).
-    solution.sides = witnesses;
-    solution.gap = -depth;
-    solution.normal = across / depth;
-  } else if ((across - facet.depth * facet.normal).norm() <= kWitnessSlack) {
-    solution.sides = witnesses;
-  }
-  // Otherwise the facet's witnesses do not split its nearest point (cores crossing nearly
-  // coplanar: facets a tolerance apart in depth lie far apart along a thin D, and the chosen one's
-  // nearest point is off its parallelogram; found by fuzz_proximity, see signed_distance.hpp):
-  // the closest points, the middle of the cores' intersection, stand in, off the facet by the
-  // depth.
+  // Touching, or a flat D, leave the closest points as they are (the middle of the cores'
+  // intersection), as does the search's fallback (penetration.hpp).
+  if (facet.witnesses) solution.sides = *facet.witnesses;
   return solution;
 }
 

@@ -119,6 +119,10 @@ ClosestPair brute_force_closest(const WorldCore& a, const WorldCore& b) {
   return best;
 }
 
+long double distance_to_core(const Eigen::Vector3d& point, const WorldCore& core) {
+  return brute_force_closest({{point.cast<long double>()}}, core).distance;
+}
+
 SignedCoreDistance brute_force_signed_distance(const WorldCore& a, const WorldCore& b,
                                                long double scale) {
   const ClosestPair closest = brute_force_closest(a, b);
@@ -153,6 +157,54 @@ SignedCoreDistance brute_force_signed_distance(const WorldCore& a, const WorldCo
   }
   if (best.s == std::numeric_limits<long double>::infinity()) return {0, Vec3L::Zero()};
   return {-best.s, best.normal};
+}
+
+namespace {
+
+long double support(const WorldCore& core, const Vec3L& n) {
+  long double best = -std::numeric_limits<long double>::infinity();
+  for (const auto& v : core.vertices) best = std::max(best, n.dot(v));
+  return best;
+}
+
+// The core's edge directions (unnormalized): a segment's one, a polygon's every side.
+std::vector<Vec3L> edge_directions(const WorldCore& core) {
+  std::vector<Vec3L> edges;
+  const std::size_t n = core.vertices.size();
+  if (n == 2) edges.push_back(core.vertices[1] - core.vertices[0]);
+  if (n >= 3) {
+    for (std::size_t i = 0; i < n; ++i)
+      edges.push_back(core.vertices[(i + 1) % n] - core.vertices[i]);
+  }
+  return edges;
+}
+
+// A polygon's unit normal (from its first three vertices, which are not collinear for a reduced
+// polygon), or none.
+std::vector<Vec3L> face_normals(const WorldCore& core) {
+  if (core.vertices.size() < 3) return {};
+  const Vec3L n = (core.vertices[1] - core.vertices[0]).cross(core.vertices[2] - core.vertices[0]);
+  return {n / n.norm()};
+}
+
+}  // namespace
+
+long double brute_force_penetration_depth(const WorldCore& a, const WorldCore& b) {
+  std::vector<Vec3L> axes = face_normals(a);
+  for (const Vec3L& n : face_normals(b)) axes.push_back(n);
+  for (const Vec3L& e : edge_directions(a)) {
+    for (const Vec3L& f : edge_directions(b)) {
+      const Vec3L c = e.cross(f);
+
+      if (c.norm() > 1e-15L * e.norm() * f.norm()) axes.push_back(c / c.norm());
+    }
+  }
+  long double depth = std::numeric_limits<long double>::infinity();
+  for (const Vec3L& n : axes) {
+    depth = std::min(depth, support(a, n) + support(b, -n));
+    depth = std::min(depth, support(a, -n) + support(b, n));
+  }
+  return depth == std::numeric_limits<long double>::infinity() ? 0 : std::max(depth, 0.0L);
 }
 
 }  // namespace diffpills::testing

@@ -24,6 +24,9 @@ struct ClosestPair {
 
 ClosestPair brute_force_closest(const WorldCore& a, const WorldCore& b);
 
+// The distance of a world point from a core (the point as a core of one vertex).
+long double distance_to_core(const Eigen::Vector3d& point, const WorldCore& core);
+
 // The signed distance of the cores, s = dist(0, D) when the cores are apart and minus the distance
 // from 0 to D's boundary when they intersect, with D = conv{va - vb} the cores' Minkowski
 // difference. Apart: brute_force_closest. Intersecting: every plane through three points of D's
@@ -36,5 +39,13 @@ struct SignedCoreDistance {
 };
 SignedCoreDistance brute_force_signed_distance(const WorldCore& a, const WorldCore& b,
                                                long double scale);
+
+// The penetration depth of intersecting cores by separating axes, for cores of many vertices where
+// the hull above is too slow: the smallest h_a(n) + h_b(-n) (support functions, max over the
+// vertices) over the candidate axes +-n: each polygon's normal and every cross product of an edge
+// of a with an edge of b (a segment is one edge). For any axis h_a(n) + h_b(-n) >= depth, and the
+// normals of D's facets are among the candidates, so the smallest is the depth, with no facet
+// tests. O(ea eb (na + nb)). Only meaningful when the cores intersect; 0 when D is flat.
+long double brute_force_penetration_depth(const WorldCore& a, const WorldCore& b);
 
 }  // namespace diffpills::testing
