@@ -518,11 +518,13 @@ gradient     (14,): d distance / d[r_a, q_a, r_b, q_b])")
       .def_readonly("penetrating", &SignedDistance::penetrating)
       .def_readonly("gradient", &SignedDistance::gradient)
       .def("__repr__",
-           [](const SignedDistance& s) {
+           [](const py::object& self) {
+             // The class's own name: a SignedDistanceJacobian shares this repr.
+             const auto& s = self.cast<const SignedDistance&>();
              std::ostringstream out;
-             out << "diffpills.SignedDistance(distance=" << s.distance << ", normal=["
-                 << s.normal.transpose() << "], penetrating=" << (s.penetrating ? "True" : "False")
-                 << ")";
+             out << "diffpills." << py::type::of(self).attr("__name__").cast<std::string>()
+                 << "(distance=" << s.distance << ", normal=[" << s.normal.transpose()
+                 << "], penetrating=" << (s.penetrating ? "True" : "False") << ")";
              return out.str();
            })
       .def(py::pickle(&signed_distance_state, [](const py::object& state) {
@@ -574,9 +576,12 @@ gradient         (14,): d phi / d[r_a, q_a, r_b, q_b])")
       .def_readonly("cores_intersect", &Proximity::cores_intersect)
       .def_readonly("gradient", &Proximity::gradient)
       .def("__repr__",
-           [](const Proximity& p) {
+           [](const py::object& self) {
+             // The class's own name: a ProximityJacobian shares this repr.
+             const auto& p = self.cast<const Proximity&>();
              std::ostringstream out;
-             out << "diffpills.Proximity(phi=" << p.phi << ", normal=[" << p.normal.transpose()
+             out << "diffpills." << py::type::of(self).attr("__name__").cast<std::string>()
+                 << "(phi=" << p.phi << ", normal=[" << p.normal.transpose()
                  << "], cores_intersect=" << (p.cores_intersect ? "True" : "False") << ")";
              return out.str();
            })

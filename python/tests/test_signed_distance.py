@@ -114,6 +114,19 @@ def test_results_made_by_new_are_refused():
         diffpills.SignedDistance.__new__(diffpills.SignedDistance).distance
 
 
+def test_repr_names_the_result_class():
+    capsule = diffpills.Capsule(1.0, 0.1)
+    above = diffpills.Pose([0, 0, 1], [1, 0, 0, 0])
+    results = {
+        "SignedDistance": diffpills.signed_distance(capsule, diffpills.Pose(), capsule, above),
+        "SignedDistanceJacobian": diffpills.signed_distance_jacobian(capsule, diffpills.Pose(), capsule, above),
+        "Proximity": diffpills.proximity(capsule, diffpills.Pose(), capsule, above),
+        "ProximityJacobian": diffpills.proximity_jacobian(capsule, diffpills.Pose(), capsule, above),
+    }
+    for name, result in results.items():
+        assert repr(result).startswith(f"diffpills.{name}("), repr(result)
+
+
 @pytest.mark.parametrize("first, second", itertools.product(MAKERS, MAKERS))
 def test_torch_gradcheck_in_penetration_and_apart(first, second):
     rng = np.random.default_rng(17)
