@@ -55,6 +55,7 @@ demo: build
 
 bench: build
 	./$(BUILD)/bench/bench_proximity --benchmark_min_time=0.2
+	./$(BUILD)/bench/bench_scene --benchmark_min_time=0.2
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')

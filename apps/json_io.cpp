@@ -1,5 +1,6 @@
 #include "json_io.hpp"
 
+#include <cstdint>
 #include <set>
 #include <stdexcept>
 
@@ -109,6 +110,74 @@ Output list(const Eigen::VectorXd& v) {
 
 }  // namespace
 
+Pose parse_pose(const Input& value, const std::string& name) {
+  if (!value.is_object()) fail(name, "must be an object with fields \"r\" and \"q\"");
+  reject_unknown_fields(value, {"r", "q"}, name);
+  const Eigen::Vector3d r = vector<3>(member(value, "r", name), name + ".r");
+  const Eigen::Vector4d q = vector<4>(member(value, "q", name), name + ".q");
+  try {
+    return Pose(r, q);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(rename_field(error.what(), "pose.", name));
+  }
+}
+
+namespace {
+
+std::uint32_t filter_bits(const Input& body, const char* key, std::uint32_t fallback,
+                          const std::string& name) {
+  const auto it = body.find(key);
+  if (it == body.end()) return fallback;
+  if (!it->is_number_unsigned() || it->get<std::uint64_t>() > 0xFFFFFFFFu) {
+    fail(name + "." + key, "must be an integer from 0 to 4294967295");
+  }
+  return static_cast<std::uint32_t>(it->get<std::uint64_t>());
+}
+
+}  // namespace
+
+Scene parse_scene(const Input& value) {
+  if (!value.is_object()) fail("scene", "must be an object with fields \"bodies\" and \"exclude\"");
+  reject_unknown_fields(value, {"bodies", "exclude"}, "scene");
+  const Input& bodies = member(value, "bodies", "scene");
+  if (!bodies.is_array()) fail("bodies", "must be an array of bodies");
+  std::vector<Body> list;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const std::string name = "bodies[" + std::to_string(i) + "]";
+    const Input& body = bodies[i];
+    if (!body.is_object()) fail(name, "must be an object with fields \"name\" and \"shapes\"");
+    reject_unknown_fields(body, {"name", "shapes", "category", "mask"}, name);
+    const Input& body_name = member(body, "name", name);
+    if (!body_name.is_string() || body_name.get<std::string>().empty()) {
+      fail(name + ".name", "must be a non-empty string");
+    }
+    const Input& shapes = member(body, "shapes", name);
+    if (!shapes.is_array()) fail(name + ".shapes", "must be an array of shapes");
+    std::vector<BodyShape> posed;
+    for (std::size_t k = 0; k < shapes.size(); ++k) {
+      PosedShape shape = parse_posed_shape(shapes[k], name + ".shapes[" + std::to_string(k) + "]");
+      posed.push_back({std::move(shape.shape), shape.pose});
+    }
+    const CollisionFilter defaults;
+    list.emplace_back(body_name.get<std::string>(), std::move(posed),
+                      CollisionFilter{filter_bits(body, "category", defaults.category, name),
+                                      filter_bits(body, "mask", defaults.mask, name)});
+  }
+  std::vector<std::pair<std::string, std::string>> exclude;
+  if (value.contains("exclude")) {
+    const Input& pairs = value["exclude"];
+    if (!pairs.is_array()) fail("exclude", "must be an array of [name, name] pairs");
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const Input& pair = pairs[k];
+      if (!pair.is_array() || pair.size() != 2 || !pair[0].is_string() || !pair[1].is_string()) {
+        fail("exclude[" + std::to_string(k) + "]", "must be a pair of body names");
+      }
+      exclude.emplace_back(pair[0].get<std::string>(), pair[1].get<std::string>());
+    }
+  }
+  return Scene(std::move(list), exclude);
+}
+
 PosedShape parse_posed_shape(const Input& value, const std::string& name) {
   if (!value.is_object()) {
     fail(name, "must be an object");
@@ -141,6 +210,35 @@ Output to_json(const Shape& shape, const Pose& pose) {
   out["r"] = list(pose.r());
   out["q"] = list(pose.q());
   return out;
+}
+
+Output to_json(const Scene& scene) {
+  Output bodies = Output::array();
+  const CollisionFilter defaults;
+  for (const Body& body : scene.bodies()) {
+    Output shapes = Output::array();
+    for (const BodyShape& shape : body.shapes()) shapes.push_back(to_json(shape.shape, shape.pose));
+    Output out = {{"name", body.name()}, {"shapes", shapes}};
+    if (body.filter().category != defaults.category) out["category"] = body.filter().category;
+    if (body.filter().mask != defaults.mask) out["mask"] = body.filter().mask;
+    bodies.push_back(out);
+  }
+  Output exclude = Output::array();
+  for (const auto& [i, j] : scene.excluded()) {
+    exclude.push_back({scene.body(i).name(), scene.body(j).name()});
+  }
+  return {{"bodies", bodies}, {"exclude", exclude}};
+}
+
+Output to_json(const Contact& contact, const Scene& scene) {
+  return {{"bodies", {scene.body(contact.bodies[0]).name(), scene.body(contact.bodies[1]).name()}},
+          {"shapes", {contact.shapes[0], contact.shapes[1]}},
+          {"distance", contact.distance},
+          {"phi", contact.phi},
+          {"points", {list(contact.points[0]), list(contact.points[1])}},
+          {"normal", list(contact.normal)},
+          {"gradient", list(contact.gradient)},
+          {"phi_gradient", list(contact.phi_gradient)}};
 }
 
 Output to_json(const Proximity& result) {

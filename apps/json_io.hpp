@@ -20,6 +20,19 @@ PosedShape parse_posed_shape(const nlohmann::json& value, const std::string& nam
 // The same schema back, for output files of the demos.
 nlohmann::ordered_json to_json(const Shape& shape, const Pose& pose);
 
+// A pose alone: {"r": [3], "q": [4]}.
+Pose parse_pose(const nlohmann::json& value, const std::string& name);
+
+// A scene file (DESIGN.md section 3c): {"bodies": [{"name": "...", "shapes": [posed shapes, in
+// the body's frame], "category": n, "mask": n}], "exclude": [["a", "b"], ...]}, with "category"
+// and "mask" (Box2D's collision filter, integers in [0, 2^32)) and "exclude" optional. Errors
+// name the field ("bodies[2].shapes[0].radius: ...").
+Scene parse_scene(const nlohmann::json& value);
+// The same schema back (the filter only where it is not the default).
+nlohmann::ordered_json to_json(const Scene& scene);
+// A contact of a scene query, bodies by name (DESIGN.md section 3c).
+nlohmann::ordered_json to_json(const Contact& contact, const Scene& scene);
+
 nlohmann::ordered_json to_json(const Proximity& result);
 nlohmann::ordered_json to_json(const ProximityJacobian& result);
 // DESIGN.md section 3b: distance, points, normal, gradient (and core_points, penetrating); with

@@ -1,12 +1,14 @@
-// The diffpills command: `diffpills query` (JSON Lines) and `diffpills demo`.
+// The diffpills command: `diffpills query` and `diffpills scene` (JSON Lines), `diffpills demo`.
 #include <cerrno>
 #include <csignal>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "demo_scene.hpp"
 #include "diffpills/version.hpp"
 #include "query.hpp"
+#include "scene_command.hpp"
 
 namespace {
 
@@ -17,6 +19,9 @@ Differentiable collision detection for capsules and padded polygons.
 commands:
   query      Read one JSON query per line on standard input and write one JSON answer per
              line on standard output, in the same order.
+  scene SCENE.json [--margin M]
+             Load a scene of bodies (each a set of posed shapes), then read one line of body
+             poses per query and answer every pair of shapes of two bodies within the margin.
   demo       Print phi, closest points, normal and gradient for the paper's Fig. 1 scene.
   --help     Show this text.   --version   Show the version.
 
@@ -48,10 +53,24 @@ An answer:
   than 64 MiB is answered with an error too. A UTF-8 byte order mark and a CR before the line
   end are ignored.
 
+A scene file (`diffpills scene`):
+  {"bodies": [{"name": "link1", "shapes": [<shape as in a query, r and q in the body's frame>],
+               "category": 1, "mask": 4294967295},   (category and mask optional)
+              ...],
+   "exclude": [["link1", "link2"], ...]}              (optional)
+  A scene query: {"poses": {"link1": {"r": [...], "q": [...]}, ...}, "margin": 0.1}
+  (every body posed; margin optional, overriding --margin, default 0). Its answer:
+  {"contacts": [{"bodies": ["link1", "table"], "shapes": [0, 0], "distance": ...,
+     "phi": ..., "points": [x~1, x~2], "normal": [...], "gradient": [14 numbers:
+     d distance/d(r_body1, q_body1, r_body2, q_body2)], "phi_gradient": [14 numbers]}]}
+  every pair of shapes of two bodies not excluded (and whose categories and masks match)
+  with signed distance <= margin, sorted by the bodies' order in the file, then the shapes.
+  A bad scene file or argument ends the command with status 2 and a message naming the field.
+
 exit status:
   0  every line was answered with a result
   1  some line was answered with an error
-  2  the command was misused (unknown command, extra arguments)
+  2  the command was misused (unknown command, extra arguments, a bad scene file)
   3  reading standard input or writing standard output failed (full disk, closed pipe, ...);
      a message on standard error says which, and the command stops there
 )";
@@ -77,6 +96,11 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
   if (argc < 2) return misuse("missing command");
   const std::string command = argv[1];
+  if (command == "scene") {
+    std::ios::sync_with_stdio(false);
+    return diffpills::app::run_scene_command(std::vector<std::string>(argv + 2, argv + argc),
+                                             std::cin, std::cout);
+  }
   if (argc > 2) {
     return misuse("unexpected argument '" + std::string(argv[2]) + "' after '" + command + "'" +
                   (command == "query" ? " (queries are read from standard input)" : ""));

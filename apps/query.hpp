@@ -1,26 +1,12 @@
 // `diffpills query`: JSON Lines in, JSON Lines out (DESIGN.md section 3).
 #pragma once
 
-#include <cstddef>
 #include <iostream>
 #include <string>
 
+#include "json_lines.hpp"
+
 namespace diffpills::app {
-
-// The exit statuses of the command (documented in its --help and in the README).
-enum ExitStatus : int {
-  kEveryLineAnswered = 0,
-  kSomeLineAnError = 1,
-  kMisuse = 2,
-  kInputOutputFailed = 3,  // reading standard input or writing standard output failed
-};
-
-// Lines longer than this are answered with an error, and the command keeps only this much of one
-// in memory. A polygon of 10^6 vertices in full-precision numbers is about 45 MB, so it fits,
-// while what one line can cost stays bounded: parsed, a line of tiny arrays ([0,0],[0,0],...)
-// takes about 22 times its length, 1.5 GB at this limit, and one of empty objects ([{},{},...])
-// about 33 times, 2.1 GB (measured). Running out of memory is answered with an error line.
-constexpr std::size_t kMaxLineBytes = std::size_t{64} << 20;
 
 // Answers one query line: the result object, or {"error": "..."} naming the field at fault. The
 // answer is one line of valid UTF-8 JSON whatever bytes the query held (bytes that are not UTF-8
@@ -33,10 +19,5 @@ std::string answer_query_line(const std::string& line, bool& ok);
 // kInputOutputFailed (after saying why on `diagnostics`) as soon as a write to `out` fails or if
 // reading `in` fails.
 int run_query(std::istream& in, std::ostream& out, std::ostream& diagnostics = std::cerr);
-
-// Flushes `out`, standard output of the command. If this or an earlier write failed, says so on
-// `diagnostics` ("diffpills: cannot write to standard output: <errno's reason>"; set errno to 0
-// before writing for the reason to be this write's) and returns false.
-bool flush_standard_output(std::ostream& out, std::ostream& diagnostics);
 
 }  // namespace diffpills::app

@@ -35,6 +35,17 @@ Eigen::Matrix4d left_multiply_matrix(const Eigen::Vector4d& q) {
   return l;
 }
 
+// p (x) q = [p0 w - pv.v ; p0 v + w pv + pv x v] = [w p0 - v.pv ; w pv + p0 v - v x pv], so
+// R(q) = [ w  -v^T ; v  w I - [v]x ].
+Eigen::Matrix4d right_multiply_matrix(const Eigen::Vector4d& q) {
+  Eigen::Matrix4d r;
+  r(0, 0) = q(0);
+  r.block<1, 3>(0, 1) = -q.tail<3>().transpose();
+  r.block<3, 1>(1, 0) = q.tail<3>();
+  r.block<3, 3>(1, 1) = q(0) * Eigen::Matrix3d::Identity() - detail::skew(q.tail<3>());
+  return r;
+}
+
 Eigen::Matrix<double, 4, 3> attitude_jacobian(const Eigen::Vector4d& q) {
   return left_multiply_matrix(q).rightCols<3>();
 }

@@ -70,7 +70,7 @@ TEST(Rotation, JacobiansMatchCentralDifferences) {
   }
 }
 
-TEST(Rotation, LeftMultiplyAndAttitudeJacobian) {
+TEST(Rotation, LeftAndRightMultiplyAndAttitudeJacobian) {
   Rng rng(3);
   for (int i = 0; i < 500; ++i) {
     const Eigen::Vector4d q = random_quaternion(rng);
@@ -79,6 +79,7 @@ TEST(Rotation, LeftMultiplyAndAttitudeJacobian) {
         Eigen::Quaterniond(q(0), q(1), q(2), q(3)) * Eigen::Quaterniond(p(0), p(1), p(2), p(3));
     const Eigen::Vector4d expected(product.w(), product.x(), product.y(), product.z());
     EXPECT_LE((left_multiply_matrix(q) * p - expected).norm(), 1e-13);
+    EXPECT_LE((right_multiply_matrix(p) * q - expected).norm(), 1e-13);  // Eigen's product
     // dq/dtheta of q (x) [1, theta/2] is 1/2 G(q).
     const Eigen::Matrix<double, 4, 3> G = attitude_jacobian(q);
     for (int j = 0; j < 3; ++j) {

@@ -8,6 +8,7 @@
 #include "diffpills/qp/box_active_set.hpp"
 #include "diffpills/qp/interior_point.hpp"
 #include "diffpills/rotation.hpp"
+#include "diffpills/scene.hpp"
 #include "diffpills/shapes.hpp"
 #include "diffpills/signed_distance.hpp"
 #include "diffpills/version.hpp"

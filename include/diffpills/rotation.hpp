@@ -29,6 +29,10 @@ Eigen::Matrix<double, 3, 4> rotate_transpose_jacobian(const Eigen::Vector4d& q,
 // L(q): the left-multiplication matrix, q (x) p = L(q) p.
 Eigen::Matrix4d left_multiply_matrix(const Eigen::Vector4d& q);
 
+// R(q): the right-multiplication matrix, p (x) q = R(q) p. (Chains a gradient through a
+// composition of attitudes: d(p (x) q)/dp = R(q).)
+Eigen::Matrix4d right_multiply_matrix(const Eigen::Vector4d& q);
+
 // G(q) = L(q) H with H = [0; I3] (4x3): the attitude Jacobian. For the body-frame perturbation
 // q (x) [1, theta/2], dq/dtheta = 1/2 G(q) at theta = 0.
 Eigen::Matrix<double, 4, 3> attitude_jacobian(const Eigen::Vector4d& q);

@@ -13,21 +13,30 @@ Shapes: ``Capsule(length, radius)`` and ``PaddedPolygon(C, d, radius)``, each po
     the signed distance (the gap, or minus the penetration depth) with its exact gradient, which
     keeps a slope where phi is flat (overlapping cores).
 
+``Body(name, [(shape, pose), ...])`` and ``Scene(bodies, exclude)``
+    rigid sets of primitives and scenes of named bodies; ``scene.contacts(r, q, margin)`` returns
+    every pair of shapes of two bodies within the margin, with gradients with respect to the
+    body poses, as NumPy arrays (a ``Contacts`` named tuple).
+
 ``phi = ||p1 - p2||^2 - (R1 + R2)^2`` is negative exactly when the shapes overlap. Bad input raises
 ValueError (a bad value or shape) or TypeError (a wrong type: complex numbers, a str, a tensor that
 requires grad) naming the field. ``import diffpills.torch`` for ``diffpills.torch.proximity`` and
-``diffpills.torch.signed_distance``, PyTorch autograd functions over batches (not imported here, so that ``import diffpills`` stays fast
+``diffpills.torch.signed_distance`` and ``diffpills.torch.scene_contacts``, PyTorch autograd
+functions over batches and scenes (not imported here, so that ``import diffpills`` stays fast
 without PyTorch).
 """
 
 from ._core import (
+    Body,
     Capsule,
+    Contacts,
     PaddedPolygon,
     Pose,
     Proximity,
     ProximityJacobian,
     SignedDistance,
     SignedDistanceJacobian,
+    Scene,
     SolverError,
     __version__,
     proximity,
@@ -39,13 +48,16 @@ from ._core import (
 )
 
 __all__ = [
+    "Body",
     "Capsule",
+    "Contacts",
     "PaddedPolygon",
     "Pose",
     "Proximity",
     "ProximityJacobian",
     "SignedDistance",
     "SignedDistanceJacobian",
+    "Scene",
     "SolverError",
     "__version__",
     "proximity",
@@ -55,3 +67,32 @@ __all__ = [
     "signed_distance_batch",
     "signed_distance_jacobian",
 ]
+
+
+def _restore(cls, state):
+    """Rebuilds a pickled diffpills object from its state (any pickle protocol)."""
+    instance = cls.__new__(cls)
+    instance.__setstate__(state)
+    return instance
+
+
+def _reduce_ex(self, protocol):
+    # pickle protocols 0 and 1 go through copyreg._reduce_ex, which for pybind11 classes ends the
+    # interpreter (pybind11 issue 3745: "new instance has no pybind11-registered base types"); every
+    # protocol takes this path instead.
+    return _restore, (type(self), self.__getstate__())
+
+
+for _class in (
+    Body,
+    Capsule,
+    PaddedPolygon,
+    Pose,
+    Proximity,
+    ProximityJacobian,
+    Scene,
+    SignedDistance,
+    SignedDistanceJacobian,
+):
+    _class.__reduce_ex__ = _reduce_ex
+del _class

@@ -1,7 +1,7 @@
 # Type stubs for diffpills._core (the pybind11 module), re-exported by the package diffpills.
 # Arrays and numbers must hold real numbers (floats or ints of any width); complex, bool and str
 # raise TypeError at run time.
-from typing import Literal, Optional, Tuple, Union, overload
+from typing import List, Literal, NamedTuple, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -113,3 +113,44 @@ def signed_distance_batch(
     threads: int = 0,
     out: Optional[Tuple[np.ndarray, np.ndarray]] = None,
 ) -> Tuple[np.ndarray, np.ndarray]: ...
+
+class Body:
+    def __init__(
+        self,
+        name: str,
+        shapes: Sequence[Tuple[Shape, Pose]],
+        category: int = 1,
+        mask: int = 0xFFFFFFFF,
+    ) -> None: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def shapes(self) -> List[Tuple[Shape, Pose]]: ...
+    @property
+    def category(self) -> int: ...
+    @property
+    def mask(self) -> int: ...
+
+class Contacts(NamedTuple):
+    bodies: np.ndarray
+    shapes: np.ndarray
+    distance: np.ndarray
+    phi: np.ndarray
+    points: np.ndarray
+    normal: np.ndarray
+    gradient: np.ndarray
+    phi_gradient: np.ndarray
+
+class Scene:
+    def __init__(
+        self, bodies: Sequence[Body], exclude: Optional[Sequence[Tuple[str, str]]] = None
+    ) -> None: ...
+    def __len__(self) -> int: ...
+    @property
+    def bodies(self) -> List[Body]: ...
+    @property
+    def names(self) -> List[str]: ...
+    @property
+    def exclude(self) -> List[Tuple[str, str]]: ...
+    def index_of(self, name: str) -> int: ...
+    def contacts(self, r: ArrayLike, q: ArrayLike, margin: float = 0.0) -> Contacts: ...

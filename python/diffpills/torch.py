@@ -1,5 +1,6 @@
 """PyTorch autograd for diffpills: ``diffpills.torch.proximity`` and
-``diffpills.torch.signed_distance`` over batches of poses.
+``diffpills.torch.signed_distance`` over batches of poses, ``diffpills.torch.scene_contacts`` over
+the bodies of a scene.
 
     import torch, diffpills, diffpills.torch
     capsule = diffpills.Capsule(1.0, 0.2)
@@ -19,7 +20,7 @@ import torch
 
 from . import _core
 
-__all__ = ["proximity", "signed_distance"]
+__all__ = ["proximity", "scene_contacts", "signed_distance"]
 
 
 def _refuse_second_derivatives():
@@ -129,3 +130,62 @@ def _apply(batch, a, b, options, r_a, q_a, r_b, q_b):
     # expand() is a view whose backward sums over the shared rows.
     r_a, q_a, r_b, q_b = (t.expand(n, t.shape[1]) for t in (r_a, q_a, r_b, q_b))
     return _Batch.apply(batch, a, b, options, r_a, q_a, r_b, q_b)
+
+
+class _SceneContacts(torch.autograd.Function):
+    """The contacts of a scene: distance and phi (K,) differentiable with respect to the body
+    poses r (n, 3), q (n, 4); the rest returned alongside, not differentiable."""
+
+    @staticmethod
+    def forward(ctx, scene, margin, r, q):
+        found = scene.contacts(_as_numpy(r), _as_numpy(q), margin)
+        like = {"device": r.device, "dtype": r.dtype}
+        bodies = torch.from_numpy(found.bodies.astype(np.int64)).to(device=r.device)
+        ctx.save_for_backward(
+            bodies,
+            torch.from_numpy(found.gradient).to(**like),
+            torch.from_numpy(found.phi_gradient).to(**like),
+        )
+        ctx.bodies = r.shape[0]
+        others = (
+            bodies,
+            torch.from_numpy(found.shapes.astype(np.int64)).to(device=r.device),
+            torch.from_numpy(found.points).to(**like),
+            torch.from_numpy(found.normal).to(**like),
+            torch.from_numpy(found.gradient).to(**like),
+            torch.from_numpy(found.phi_gradient).to(**like),
+        )
+        ctx.mark_non_differentiable(*others)
+        return (torch.from_numpy(found.distance).to(**like), torch.from_numpy(found.phi).to(**like)) + others
+
+    @staticmethod
+    def backward(ctx, grad_distance, grad_phi, *unused):
+        _refuse_second_derivatives()
+        bodies, gradient, phi_gradient = ctx.saved_tensors
+        weighted = gradient * grad_distance.unsqueeze(1) + phi_gradient * grad_phi.unsqueeze(1)
+        grad_r = weighted.new_zeros(ctx.bodies, 3)
+        grad_q = weighted.new_zeros(ctx.bodies, 4)
+        for side, offset in ((0, 0), (1, 7)):
+            grad_r.index_add_(0, bodies[:, side], weighted[:, offset : offset + 3])
+            grad_q.index_add_(0, bodies[:, side], weighted[:, offset + 3 : offset + 7])
+        return None, None, grad_r, grad_q
+
+
+def scene_contacts(scene, r, q, margin=0.0):
+    """The contacts of ``scene`` (a ``diffpills.Scene``) with its bodies at poses r (n, 3) and
+    q (n, 4) (one row per body, in the scene's order): a ``diffpills.Contacts`` of tensors, whose
+    ``distance`` and ``phi`` (K,) are differentiable with respect to r and q through the exact
+    gradients (chain rule through the shapes' local poses, quaternion normalization included);
+    ``bodies`` and ``shapes`` (K, 2) are int64, the rest as in ``Scene.contacts``, not
+    differentiable. The set of contacts (pairs within ``margin``) is taken at the given poses.
+    r and q must share one dtype (float64 or float32) and device; errors as ``Scene.contacts``.
+    """
+    r, q = _rows("r", r, 3), _rows("q", q, 4)
+    for name, tensor in (("r", r), ("q", q)):
+        if tensor.dtype not in (torch.float64, torch.float32):
+            raise ValueError(f"{name}: expected float64 or float32, got {tensor.dtype}")
+    if q.dtype != r.dtype or q.device != r.device:
+        raise ValueError("q: dtype and device must match r's")
+    outputs = _SceneContacts.apply(scene, margin, r, q)
+    distance, phi, bodies, shapes, points, normal, gradient, phi_gradient = outputs
+    return _core.Contacts(bodies, shapes, distance, phi, points, normal, gradient, phi_gradient)

@@ -3,7 +3,7 @@ from typing import Literal
 
 import torch
 
-from ._core import Shape
+from ._core import Contacts, Scene, Shape
 
 def proximity(
     a: Shape,
@@ -24,3 +24,6 @@ def signed_distance(
     q_b: torch.Tensor,
     threads: int = 0,
 ) -> torch.Tensor: ...
+def scene_contacts(
+    scene: Scene, r: torch.Tensor, q: torch.Tensor, margin: float = 0.0
+) -> Contacts: ...

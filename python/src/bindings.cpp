@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstdint>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -79,6 +80,12 @@ class type_caster<diffpills::SignedDistance>
 template <>
 class type_caster<diffpills::SignedDistanceJacobian>
     : public diffpills::python::ConstructedCaster<diffpills::SignedDistanceJacobian> {};
+template <>
+class type_caster<diffpills::Body> : public diffpills::python::ConstructedCaster<diffpills::Body> {
+};
+template <>
+class type_caster<diffpills::Scene>
+    : public diffpills::python::ConstructedCaster<diffpills::Scene> {};
 }  // namespace pybind11::detail
 
 namespace diffpills::python {
@@ -748,6 +755,266 @@ py::tuple signed_distance_batch_of(const py::handle& a, const py::handle& r_a,
                   [&](const auto&... args) { signed_distance_batch(args..., options); });
 }
 
+// A Python int as a 32-bit filter mask (Box2D's category and mask), or an error naming it.
+std::uint32_t filter_bits(const py::handle& value, const std::string& name) {
+  if (py::isinstance<py::bool_>(value) || !PyIndex_Check(value.ptr())) {
+    throw py::type_error(name + ": expected an int, got " + type_name(value));
+  }
+  const auto number = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!number) {
+    PyErr_Clear();
+    throw py::type_error(name + ": expected an int, got " + type_name(value));
+  }
+  int overflow = 0;
+  const long long bits = PyLong_AsLongLongAndOverflow(number.ptr(), &overflow);
+  if (overflow != 0 || bits < 0 || bits > 0xFFFFFFFFLL) {
+    throw py::value_error(name + ": must be from 0 to 4294967295, got " +
+                          std::string(py::str(number)));
+  }
+  return static_cast<std::uint32_t>(bits);
+}
+
+// A Python str as a std::string (a str with a lone surrogate has no UTF-8 form: refused).
+std::string text(const py::handle& value, const std::string& name) {
+  if (!py::isinstance<py::str>(value)) {
+    throw py::type_error(name + ": expected a str, got " + type_name(value));
+  }
+  Py_ssize_t size = 0;
+  const char* data = PyUnicode_AsUTF8AndSize(value.ptr(), &size);
+  if (data == nullptr) {
+    PyErr_Clear();
+    throw py::value_error(name + ": not valid as UTF-8 (a lone surrogate?)");
+  }
+  return std::string(data, static_cast<std::size_t>(size));
+}
+
+Body body_from(const py::handle& name, const py::handle& shapes, const py::handle& category,
+               const py::handle& mask) {
+  if (!py::isinstance<py::sequence>(shapes) || py::isinstance<py::str>(shapes)) {
+    throw py::type_error("shapes: expected a list of (shape, pose) pairs, got " +
+                         type_name(shapes));
+  }
+  std::vector<BodyShape> posed;
+  const auto list = py::reinterpret_borrow<py::sequence>(shapes);
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string field = "shapes[" + std::to_string(k) + "]";
+    const py::object item = list[k];
+    if (!py::isinstance<py::tuple>(item) || py::len(item) != 2) {
+      throw py::type_error(field + ": expected a (shape, pose) pair, got " + type_name(item));
+    }
+    posed.push_back(
+        {to_shape(item[py::int_(0)], field + "[0]"), to_pose(item[py::int_(1)], field + "[1]")});
+  }
+  return Body(text(name, "name"), std::move(posed),
+              CollisionFilter{filter_bits(category, "category"), filter_bits(mask, "mask")});
+}
+
+py::list body_shapes(const Body& body) {
+  py::list out;
+  for (const BodyShape& shape : body.shapes()) {
+    out.append(py::make_tuple(std::visit([](const auto& s) { return py::cast(s); }, shape.shape),
+                              shape.pose));
+  }
+  return out;
+}
+
+Scene scene_from(const py::handle& bodies, const py::handle& exclude) {
+  if (!py::isinstance<py::sequence>(bodies) || py::isinstance<py::str>(bodies)) {
+    throw py::type_error("bodies: expected a list of diffpills.Body, got " + type_name(bodies));
+  }
+  std::vector<Body> list;
+  const auto items = py::reinterpret_borrow<py::sequence>(bodies);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const std::string field = "bodies[" + std::to_string(i) + "]";
+    const py::object item = items[i];
+    if (!py::isinstance<Body>(item)) {
+      throw py::type_error(field + ": expected diffpills.Body, got " + type_name(item));
+    }
+    list.push_back(value_of<Body>(item, field));
+  }
+  std::vector<std::pair<std::string, std::string>> pairs;
+  if (!exclude.is_none()) {
+    if (!py::isinstance<py::sequence>(exclude) || py::isinstance<py::str>(exclude)) {
+      throw py::type_error("exclude: expected a list of (name, name) pairs, got " +
+                           type_name(exclude));
+    }
+    const auto excluded = py::reinterpret_borrow<py::sequence>(exclude);
+    for (std::size_t k = 0; k < excluded.size(); ++k) {
+      const std::string field = "exclude[" + std::to_string(k) + "]";
+      const py::object pair = excluded[k];
+      if (!py::isinstance<py::sequence>(pair) || py::isinstance<py::str>(pair) ||
+          py::len(pair) != 2) {
+        throw py::type_error(field + ": expected a (name, name) pair, got " + type_name(pair));
+      }
+      pairs.emplace_back(text(pair[py::int_(0)], field + "[0]"),
+                         text(pair[py::int_(1)], field + "[1]"));
+    }
+  }
+  return Scene(std::move(list), pairs);
+}
+
+py::list body_list(const Scene& scene) {
+  py::list out;
+  for (const Body& body : scene.bodies()) out.append(py::cast(body));
+  return out;
+}
+
+py::list excluded_names(const Scene& scene) {
+  py::list out;
+  for (const auto& [i, j] : scene.excluded()) {
+    out.append(py::make_tuple(scene.body(i).name(), scene.body(j).name()));
+  }
+  return out;
+}
+
+// Scene.contacts: the poses as arrays (one row per body), the answer as NumPy arrays in a
+// diffpills.Contacts named tuple.
+py::object scene_contacts(const Scene& scene, const py::handle& r, const py::handle& q,
+                          const py::handle& margin_value, const py::object& contacts_type) {
+  const Array r_array = as_array(r, "r"), q_array = as_array(q, "q");
+  const auto n = static_cast<py::ssize_t>(scene.size());
+  if (r_array.ndim() != 2 || r_array.shape(0) != n || r_array.shape(1) != 3) {
+    throw py::value_error("r: expected shape (" + std::to_string(n) +
+                          ", 3), one row per body, got " + shape_of(r_array));
+  }
+  if (q_array.ndim() != 2 || q_array.shape(0) != n || q_array.shape(1) != 4) {
+    throw py::value_error("q: expected shape (" + std::to_string(n) +
+                          ", 4), one row per body, got " + shape_of(q_array));
+  }
+  const double margin = real_number(margin_value, "margin");
+  std::vector<Pose> poses;
+  poses.reserve(static_cast<std::size_t>(n));
+  for (py::ssize_t i = 0; i < n; ++i) {
+    try {
+      poses.emplace_back(Eigen::Map<const Eigen::Vector3d>(r_array.data() + 3 * i),
+                         Eigen::Map<const Eigen::Vector4d>(q_array.data() + 4 * i));
+    } catch (const std::invalid_argument& error) {
+      // "pose.q: ..." as "q[3]: ..."
+      const std::string message = error.what();
+      const std::string field = message.rfind("pose.r", 0) == 0 ? "r" : "q";
+      throw py::value_error(field + "[" + std::to_string(i) + "]" + message.substr(6));
+    }
+  }
+  std::vector<Contact> found;
+  {
+    py::gil_scoped_release release;
+    found = scene.contacts(poses, margin);
+  }
+  const auto k = static_cast<py::ssize_t>(found.size());
+  py::array_t<int> bodies({k, py::ssize_t{2}}), shapes({k, py::ssize_t{2}});
+  py::array_t<double> distance(k), phi(k), points({k, py::ssize_t{2}, py::ssize_t{3}}),
+      normal({k, py::ssize_t{3}}), gradient({k, py::ssize_t{14}}),
+      phi_gradient({k, py::ssize_t{14}});
+  auto b = bodies.mutable_unchecked<2>();
+  auto s = shapes.mutable_unchecked<2>();
+  auto d = distance.mutable_unchecked<1>();
+  auto f = phi.mutable_unchecked<1>();
+  auto p = points.mutable_unchecked<3>();
+  auto nv = normal.mutable_unchecked<2>();
+  auto g = gradient.mutable_unchecked<2>();
+  auto fg = phi_gradient.mutable_unchecked<2>();
+  for (py::ssize_t c = 0; c < k; ++c) {
+    const Contact& contact = found[static_cast<std::size_t>(c)];
+    for (int j = 0; j < 2; ++j) {
+      b(c, j) = contact.bodies[static_cast<std::size_t>(j)];
+      s(c, j) = contact.shapes[static_cast<std::size_t>(j)];
+      for (int i = 0; i < 3; ++i) p(c, j, i) = contact.points[static_cast<std::size_t>(j)](i);
+    }
+    d(c) = contact.distance;
+    f(c) = contact.phi;
+    for (int i = 0; i < 3; ++i) nv(c, i) = contact.normal(i);
+    for (int i = 0; i < 14; ++i) {
+      g(c, i) = contact.gradient(i);
+      fg(c, i) = contact.phi_gradient(i);
+    }
+  }
+  return contacts_type(bodies, shapes, distance, phi, points, normal, gradient, phi_gradient);
+}
+
+void bind_scene(py::module_& m) {
+  m.attr("Contacts") =
+      py::module_::import("collections")
+          .attr("namedtuple")(
+              "Contacts", py::make_tuple("bodies", "shapes", "distance", "phi", "points", "normal",
+                                         "gradient", "phi_gradient"));
+  m.attr("Contacts").attr("__module__") = "diffpills";
+  m.attr("Contacts").attr("__doc__") =
+      R"(The contacts of a scene query, K of them, as NumPy arrays: bodies (K, 2) and shapes (K, 2)
+(ints: the two bodies' indices, the first earlier in the scene, and each one's shape index),
+distance (K,) (signed distance), phi (K,), points (K, 2, 3) (witness points on the two surfaces),
+normal (K, 3) (unit, from the first body's shape to the other), gradient (K, 14) (of distance) and
+phi_gradient (K, 14), both with respect to [r, q] of the first body, then of the second.)";
+
+  py::class_<Body>(m, "Body", R"(A rigid body made of primitives, each posed in the body's frame.
+
+Body(name, shapes, category=1, mask=0xFFFFFFFF): shapes is a list of (shape, pose) pairs
+(diffpills.Capsule or diffpills.PaddedPolygon, and diffpills.Pose in the body frame). category and
+mask are Box2D's collision filter: two bodies are checked against each other only if each one's
+category shares a bit with the other's mask.)")
+      .def(py::init(&body_from), py::arg("name"), py::arg("shapes"), py::arg("category") = 1,
+           py::arg("mask") = 0xFFFFFFFFu)
+      .def_property_readonly("name", &Body::name)
+      .def_property_readonly("shapes", &body_shapes, "The (shape, pose) pairs, as given.")
+      .def_property_readonly("category", [](const Body& b) { return b.filter().category; })
+      .def_property_readonly("mask", [](const Body& b) { return b.filter().mask; })
+      .def("__repr__",
+           [](const Body& b) {
+             return "diffpills.Body('" + b.name() + "', " + std::to_string(b.shapes().size()) +
+                    " shapes)";
+           })
+      .def(py::pickle(
+          [](const Body& b) -> py::object {
+            return py::make_tuple(b.name(), body_shapes(b), b.filter().category, b.filter().mask);
+          },
+          [](const py::object& state) {
+            const py::tuple fields = pickled_state(state, 4, "(name, shapes, category, mask)");
+            return body_from(fields[0], fields[1], fields[2], fields[3]);
+          }));
+
+  py::class_<Scene>(m, "Scene", R"(Named bodies, some pairs of them excluded from each other.
+
+Scene(bodies, exclude=None): bodies a list of diffpills.Body with distinct names, exclude a list of
+(name, name) pairs never checked against each other (adjacent links of an arm). Immutable;
+contacts() may run in several threads at once (it releases the GIL).
+
+contacts(r, q, margin=0.0): r (n, 3) and q (n, 4), one pose per body in the scene's order; returns
+a diffpills.Contacts of every pair of shapes of two checked bodies whose signed distance is at most
+margin, sorted by the bodies' indices, then the shapes'. Gradients are with respect to the BODY
+poses (chain rule through the shapes' local poses, quaternion normalization included).)")
+      .def(py::init(&scene_from), py::arg("bodies"), py::arg("exclude") = py::none())
+      .def("__len__", &Scene::size)
+      .def_property_readonly("bodies", &body_list, "The bodies, in order.")
+      .def_property_readonly("names",
+                             [](const Scene& s) {
+                               py::list out;
+                               for (const Body& b : s.bodies()) out.append(b.name());
+                               return out;
+                             })
+      .def_property_readonly("exclude", &excluded_names, "The excluded pairs, by name, sorted.")
+      .def(
+          "index_of",
+          [](const Scene& s, const py::handle& name) { return s.index_of(text(name, "name")); },
+          py::arg("name"), "The index of the body of that name, or -1.")
+      .def(
+          "contacts",
+          [contacts_type = py::object(m.attr("Contacts"))](
+              const Scene& s, const py::handle& r, const py::handle& q, const py::handle& margin) {
+            return scene_contacts(s, r, q, margin, contacts_type);
+          },
+          py::arg("r"), py::arg("q"), py::arg("margin") = 0.0)
+      .def("__repr__",
+           [](const Scene& s) {
+             return "diffpills.Scene(" + std::to_string(s.size()) + " bodies, " +
+                    std::to_string(s.excluded().size()) + " excluded pairs)";
+           })
+      .def(py::pickle([](const Scene& s)
+                          -> py::object { return py::make_tuple(body_list(s), excluded_names(s)); },
+                      [](const py::object& state) {
+                        const py::tuple fields = pickled_state(state, 2, "(bodies, exclude)");
+                        return scene_from(fields[0], fields[1]);
+                      }));
+}
+
 }  // namespace
 }  // namespace diffpills::python
 
@@ -780,6 +1047,7 @@ the field; import diffpills.torch for a PyTorch autograd function over batches.)
       "never returns an unverified answer.";
   bind_shapes(m);
   bind_results(m);
+  bind_scene(m);
 
   m.def(
       "proximity",

@@ -1,0 +1,109 @@
+#include "json_lines.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <istream>
+#include <new>
+#include <ostream>
+#include <stdexcept>
+
+#include "json_line.hpp"
+
+namespace diffpills::app {
+namespace {
+
+// An error quoting a huge token or key is cut here: the field and the problem come first, and a
+// message of megabytes helps nobody.
+constexpr std::size_t kMaxErrorBytes = 1000;
+
+// One line of JSON in valid UTF-8: a message may quote bytes of the query that are not UTF-8
+// (nlohmann's dump would throw on them), they become U+FFFD.
+std::string to_line(const nlohmann::ordered_json& value) {
+  return value.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+}
+
+std::string error_answer(std::string message) {
+  if (message.size() > kMaxErrorBytes) {
+    message.resize(kMaxErrorBytes);
+    message += " ...";
+  }
+  return to_line({{"error", std::move(message)}});
+}
+
+// Reads the next line of `in` without its '\n', like std::getline, but keeps at most
+// kMaxLineBytes + 1 of its bytes and skips the rest: a line of any length costs bounded memory
+// and is still answered (as too long). Returns false at the end of the input or when reading
+// fails (then in.bad()).
+bool read_line(std::istream& in, std::string& line) {
+  line.clear();
+  const std::istream::sentry sentry(in, /*noskipws=*/true);
+  if (!sentry) return false;
+  using traits = std::istream::traits_type;
+  std::streambuf& buffer = *in.rdbuf();
+  try {
+    for (auto c = buffer.sbumpc();; c = buffer.sbumpc()) {
+      if (traits::eq_int_type(c, traits::eof())) {
+        in.setstate(std::ios::eofbit);
+        return !line.empty();
+      }
+      if (traits::eq_int_type(c, traits::to_int_type('\n'))) return true;
+      if (line.size() <= kMaxLineBytes) line.push_back(traits::to_char_type(c));
+    }
+  } catch (const std::ios_base::failure&) {  // libstdc++'s file buffers throw on a read error
+    in.setstate(std::ios::badbit);
+    return false;
+  }
+}
+
+std::string errno_reason() { return errno == 0 ? "" : std::string(": ") + std::strerror(errno); }
+
+}  // namespace
+
+std::string answer_line(const std::string& line, const Answer& answer, bool& ok) {
+  ok = false;
+  try {
+    if (line.size() > kMaxLineBytes) {
+      throw std::invalid_argument("query: line longer than " + std::to_string(kMaxLineBytes) +
+                                  " bytes");
+    }
+    std::string result = to_line(answer(parse_json_line(line)));
+    ok = true;
+    return result;
+  } catch (const std::bad_alloc&) {
+    return error_answer("query: not enough memory to parse this line (" +
+                        std::to_string(line.size()) + " bytes)");
+  } catch (const std::exception& error) {
+    return error_answer(error.what());
+  }
+}
+
+int run_lines(std::istream& in, std::ostream& out, std::ostream& diagnostics,
+              const Answer& answer) {
+  int status = kEveryLineAnswered;
+  std::string line;
+  for (;;) {
+    // errno is cleared before each read and write so that a failure's reason is its own.
+    errno = 0;
+    if (!read_line(in, line)) break;
+    bool ok = false;
+    const std::string answer_text = answer_line(line, answer, ok);
+    errno = 0;
+    out << answer_text << '\n';
+    if (!flush_standard_output(out, diagnostics)) return kInputOutputFailed;
+    if (!ok) status = kSomeLineAnError;
+  }
+  if (in.bad()) {
+    diagnostics << "diffpills: cannot read standard input" << errno_reason() << "\n";
+    return kInputOutputFailed;
+  }
+  return status;
+}
+
+bool flush_standard_output(std::ostream& out, std::ostream& diagnostics) {
+  out.flush();
+  if (out) return true;
+  diagnostics << "diffpills: cannot write to standard output" << errno_reason() << "\n";
+  return false;
+}
+
+}  // namespace diffpills::app

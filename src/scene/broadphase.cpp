@@ -1,0 +1,70 @@
+#include "broadphase.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "diffpills/rotation.hpp"
+
+namespace diffpills::detail {
+
+std::vector<std::pair<int, int>> broadphase(const Scene& scene, const SceneOutlines& outlines,
+                                            const std::vector<Pose>& body_poses, double margin) {
+  if (body_poses.size() != scene.bodies().size()) {
+    throw std::invalid_argument("body_poses: expected one pose per body, " +
+                                std::to_string(scene.bodies().size()) + ", got " +
+                                std::to_string(body_poses.size()));
+  }
+  if (!std::isfinite(margin) || std::abs(margin) > kMaxMagnitude) {
+    throw std::invalid_argument("margin: must be finite, of magnitude at most 1e100");
+  }
+  const double grow = 0.5 * std::max(margin, 0.0);
+  std::vector<Box> boxes(outlines.primitives.size());
+  int body = -1;  // the body whose pose R, r holds
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d r = Eigen::Vector3d::Zero();
+  for (std::size_t p = 0; p < boxes.size(); ++p) {
+    const SceneOutlines::Primitive& primitive = outlines.primitives[p];
+    if (primitive.body != body) {
+      body = primitive.body;
+      R = rotation_matrix(body_poses[static_cast<std::size_t>(body)].q());
+      r = body_poses[static_cast<std::size_t>(body)].r();
+    }
+    // The core's origin in the world (checked: the narrowphase takes it as a pose) ...
+    const Eigen::Vector3d origin =
+        r + R * scene.body(body).shapes()[static_cast<std::size_t>(primitive.shape)].pose.r();
+    if (!(origin.cwiseAbs().maxCoeff() <= kMaxMagnitude)) {
+      throw std::invalid_argument("body_poses[" + std::to_string(body) + "] (body '" +
+                                  scene.body(body).name() + "'), shape " +
+                                  std::to_string(primitive.shape) +
+                                  ": its world position is beyond 1e100 in magnitude");
+    }
+    // ... and its points.
+    Box& box = boxes[p];
+    const Eigen::Vector3d* points = outlines.points.data() + primitive.first_point;
+    box.low = box.high = r + R * points[0];
+    for (int k = 1; k < primitive.point_count; ++k) {
+      const Eigen::Vector3d v = r + R * points[k];
+      box.low = box.low.cwiseMin(v);
+      box.high = box.high.cwiseMax(v);
+    }
+    // Rounding of the corners (a few ulps of their magnitude): a relative margin far above it, so
+    // that touching shapes keep overlapping boxes.
+    const double slack =
+        primitive.radius + grow +
+        1e-12 * std::max(box.low.cwiseAbs().maxCoeff(), box.high.cwiseAbs().maxCoeff());
+    box.low.array() -= slack;
+    box.high.array() += slack;
+  }
+  std::vector<std::pair<int, int>> pairs;
+  for (auto [u, v] : overlapping_pairs(boxes)) {
+    const int body_u = outlines.primitives[static_cast<std::size_t>(u)].body;
+    const int body_v = outlines.primitives[static_cast<std::size_t>(v)].body;
+    if (!scene.checked(body_u, body_v)) continue;
+    pairs.push_back(body_u < body_v ? std::pair{u, v} : std::pair{v, u});
+  }
+  return pairs;
+}
+
+}  // namespace diffpills::detail

@@ -1,0 +1,20 @@
+// The broadphase of a scene query (scene.hpp): every primitive's world box (its body-frame points,
+// scene_outlines.hpp, moved by its body's pose and grown by its radius), and the primitive pairs
+// of checked bodies whose boxes overlap (box_tree.hpp).
+#pragma once
+
+#include <vector>
+
+#include "box_tree.hpp"
+#include "diffpills/scene.hpp"
+#include "scene_outlines.hpp"
+
+namespace diffpills::detail {
+
+// Pairs of indices into outlines.primitives whose boxes overlap, of two checked bodies, the earlier
+// body's primitive first, in no particular order. Throws std::invalid_argument as Scene::contacts
+// documents (pose count, margin, a primitive's world position beyond kMaxMagnitude).
+std::vector<std::pair<int, int>> broadphase(const Scene& scene, const SceneOutlines& outlines,
+                                            const std::vector<Pose>& body_poses, double margin);
+
+}  // namespace diffpills::detail

@@ -1,0 +1,142 @@
+// Bodies, scenes and the scene query (scene.hpp): validation, then the broadphase's pairs
+// (broadphase.hpp) through the narrowphase (signed_distance.hpp) and the chain rule from primitive
+// poses to body poses.
+#include "diffpills/scene.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <tuple>
+#include <variant>
+
+#include "broadphase.hpp"
+#include "diffpills/rotation.hpp"
+#include "diffpills/signed_distance.hpp"
+#include "scene_outlines.hpp"
+
+namespace diffpills {
+namespace {
+
+// A primitive's world pose: r + Q(q) r_l, and the unit quaternion (q (x) q_l) / (|q| |q_l|):
+// q (x) q_l itself is as good an attitude, but its entries could exceed 1e100 (or its norm fall
+// below 1e-40) where q's and q_l's do not, and the unit one is always a valid Pose. (The
+// broadphase checked r + Q(q) r_l.)
+Pose world_pose(const Pose& body_pose, const Pose& local) {
+  const Eigen::Vector4d unit = body_pose.q() / body_pose.q().norm();
+  return Pose(body_pose.r() + rotation_matrix(unit) * local.r(),
+              left_multiply_matrix(unit) * (local.q() / local.q().norm()));
+}
+
+// The body's [dr, dq] from its primitive's [dr_p, dq_p] (scene.hpp, "Chain rule"), dq_p taken at
+// the unit quaternion of world_pose: a function of the attitude alone does not change when its
+// quaternion is scaled, so its gradient scales by the inverse, and at q (x) q_l it is
+// dq_p / (|q| |q_l|).
+Eigen::Matrix<double, 7, 1> body_gradient(const Pose& body_pose, const Pose& local,
+                                          const Eigen::Matrix<double, 7, 1>& primitive) {
+  Eigen::Matrix<double, 7, 1> out;
+  out.head<3>() = primitive.head<3>();
+  out.tail<4>() = rotate_gradient(body_pose.q(), local.r(), primitive.head<3>()) +
+                  right_multiply_matrix(local.q()).transpose() * primitive.tail<4>() /
+                      (body_pose.q().norm() * local.q().norm());
+  return out;
+}
+
+double radius_of(const Shape& shape) {
+  return std::visit([](const auto& s) { return s.radius(); }, shape);
+}
+
+}  // namespace
+
+Body::Body(std::string name, std::vector<BodyShape> shapes, CollisionFilter filter)
+    : name_(std::move(name)), shapes_(std::move(shapes)), filter_(filter) {
+  if (name_.empty()) throw std::invalid_argument("body.name: must not be empty");
+}
+
+Scene::Scene() : outlines_(std::make_shared<detail::SceneOutlines>()) {}
+
+Scene::Scene(std::vector<Body> bodies,
+             const std::vector<std::pair<std::string, std::string>>& exclude)
+    : bodies_(std::move(bodies)),
+      outlines_(std::make_shared<detail::SceneOutlines>(detail::make_outlines(bodies_))) {
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    names_.emplace_back(bodies_[i].name(), static_cast<int>(i));
+  }
+  std::sort(names_.begin(), names_.end());
+  for (std::size_t k = 1; k < names_.size(); ++k) {
+    if (names_[k].first == names_[k - 1].first) {
+      const int first = std::min(names_[k].second, names_[k - 1].second);
+      const int second = std::max(names_[k].second, names_[k - 1].second);
+      throw std::invalid_argument("bodies[" + std::to_string(second) + "].name: '" +
+                                  names_[k].first + "' is also the name of bodies[" +
+                                  std::to_string(first) + "]");
+    }
+  }
+  for (std::size_t k = 0; k < exclude.size(); ++k) {
+    const std::string field = "exclude[" + std::to_string(k) + "]";
+    const int i = index_of(exclude[k].first), j = index_of(exclude[k].second);
+    for (const auto& [index, name] : {std::pair{i, &exclude[k].first}, {j, &exclude[k].second}}) {
+      if (index < 0) throw std::invalid_argument(field + ": no body is named '" + *name + "'");
+    }
+    if (i == j)
+      throw std::invalid_argument(field + ": names body '" + exclude[k].first + "' twice");
+    excluded_.emplace_back(std::min(i, j), std::max(i, j));
+  }
+  std::sort(excluded_.begin(), excluded_.end());
+  excluded_.erase(std::unique(excluded_.begin(), excluded_.end()), excluded_.end());
+}
+
+int Scene::index_of(const std::string& name) const {
+  const auto found = std::lower_bound(names_.begin(), names_.end(), std::pair{name, -1});
+  return found != names_.end() && found->first == name ? found->second : -1;
+}
+
+bool Scene::checked(int i, int j) const {
+  if (i == j) return false;
+  const CollisionFilter& a = body(i).filter();
+  const CollisionFilter& b = body(j).filter();
+  if ((a.category & b.mask) == 0 || (b.category & a.mask) == 0) return false;
+  return !std::binary_search(excluded_.begin(), excluded_.end(),
+                             std::pair{std::min(i, j), std::max(i, j)});
+}
+
+std::vector<Contact> Scene::contacts(const std::vector<Pose>& body_poses, double margin) const {
+  std::vector<Contact> found;
+  for (const auto& [u, v] : detail::broadphase(*this, *outlines_, body_poses, margin)) {
+    const detail::SceneOutlines::Primitive& first =
+        outlines_->primitives[static_cast<std::size_t>(u)];
+    const detail::SceneOutlines::Primitive& second =
+        outlines_->primitives[static_cast<std::size_t>(v)];
+    const BodyShape& a = body(first.body).shapes()[static_cast<std::size_t>(first.shape)];
+    const BodyShape& b = body(second.body).shapes()[static_cast<std::size_t>(second.shape)];
+    const Pose& pose_a = body_poses[static_cast<std::size_t>(first.body)];
+    const Pose& pose_b = body_poses[static_cast<std::size_t>(second.body)];
+    const SignedDistance sd =
+        signed_distance(a.shape, world_pose(pose_a, a.pose), b.shape, world_pose(pose_b, b.pose));
+    if (!(sd.distance <= margin)) continue;
+
+    Contact contact;
+    contact.bodies = {first.body, second.body};
+    contact.shapes = {first.shape, second.shape};
+    contact.distance = sd.distance;
+    contact.points = sd.points;
+    contact.normal = sd.normal;
+    contact.gradient << body_gradient(pose_a, a.pose, sd.gradient.head<7>()),
+        body_gradient(pose_b, b.pose, sd.gradient.tail<7>());
+    const double radii = radius_of(a.shape) + radius_of(b.shape);
+    if (sd.penetrating) {
+      contact.phi = -radii * radii;  // the cores intersect: flat (proximity.hpp)
+    } else {
+      contact.phi = sd.distance * (sd.distance + 2.0 * radii);
+      contact.phi_gradient = 2.0 * (sd.distance + radii) * contact.gradient;
+    }
+    found.push_back(contact);
+  }
+  std::sort(found.begin(), found.end(), [](const Contact& x, const Contact& y) {
+    return std::tie(x.bodies[0], x.bodies[1], x.shapes[0], x.shapes[1]) <
+           std::tie(y.bodies[0], y.bodies[1], y.shapes[0], y.shapes[1]);
+  });
+  return found;
+}
+
+}  // namespace diffpills
