@@ -277,6 +277,31 @@ BENCHMARK(PolygonPolygon_SignedDistanceCrossing)
     ->Complexity()
     ->Unit(benchmark::kMicrosecond);
 
+// Two k-gons crossing nearly parallel (a hostile review's stall): unit circumradius, the second's
+// rows turned by 0.1234 rad in its plane and its plane 1e-11 rad off the first's, through the same
+// centre. Most vertices of each lie within the tolerance of the other's support value, and each
+// support vertex's shadow is tested against the other face (penetration.cpp, ShadowTest).
+void PolygonPolygon_SignedDistanceNearlyParallel(benchmark::State& state) {
+  const auto count = static_cast<int>(state.range(0));
+  Eigen::MatrixX2d C(count, 2), turned(count, 2);
+  for (int i = 0; i < count; ++i) {
+    C.row(i) << std::cos(2 * M_PI * i / count), std::sin(2 * M_PI * i / count);
+    turned.row(i) << std::cos(0.1234 + 2 * M_PI * i / count),
+        std::sin(0.1234 + 2 * M_PI * i / count);
+  }
+  const PaddedPolygon a(C, Eigen::VectorXd::Ones(count), 0.01);
+  const PaddedPolygon b(turned, Eigen::VectorXd::Ones(count), 0.01);
+  const Pose flat, tilted(Eigen::Vector3d::Zero(), {std::cos(0.5e-11), std::sin(0.5e-11), 0, 0});
+  for (auto _ : state) benchmark::DoNotOptimize(signed_distance(a, flat, b, tilted));
+  state.SetComplexityN(count);
+}
+BENCHMARK(PolygonPolygon_SignedDistanceNearlyParallel)
+    ->RangeMultiplier(4)
+    ->Range(1024, 65536)
+    ->Arg(100000)
+    ->Complexity()
+    ->Unit(benchmark::kMillisecond);
+
 // proximity_batch over 10^5 pose pairs with 1 and 2 threads (wall-clock time).
 constexpr Eigen::Index kBatch = 100000;
 

@@ -527,6 +527,54 @@ TEST(SignedDistance, NearlyCoplanarCrossingPolygons) {
   }
 }
 
+// Near touching the closest points are a few ulps of the scene apart from exact, so the direction
+// of x2 - x1 is known only to ~1e-16 / |x2 - x1| (a hostile review: 7e-5 off for two capsules
+// 1e-12 apart, 2e-7 for a capsule through a square's face tilted 1e-10). Where the features fix
+// the normal (two edges crossing, a point over a face) it comes from them, exact to a few ulps:
+// for proximity() and signed_distance(), apart and in penetration, and the signed distance's
+// position gradient is that normal.
+TEST(SignedDistance, NormalsNearTouchingComeFromTheFeatures) {
+  Rng rng(77);
+  std::normal_distribution<double> normal;
+  const Capsule stick(1.0, 0.1);
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Quaterniond turn =
+        Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+    const Eigen::Vector3d e = turn * Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d f = turn * Eigen::Vector3d(0.6, 0.8, 0.0);  // in a's x-y plane
+    const Eigen::Vector3d n = e.cross(f).normalized();
+    // Crossing off the segments' middles (0.3 along a, -0.2 along b), s apart along n.
+    const double s = std::pow(10.0, -8.0 - 3.0 * (i % 4) / 3.0);  // above the tolerance, 1e-12
+    const Eigen::Vector3d at(0.1 * normal(rng), 0.1 * normal(rng), 0.1 * normal(rng));
+    const Eigen::Quaterniond qb =
+        Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitX(), turn.inverse() * f);
+    const Pose pa(at - 0.3 * e, Eigen::Vector4d(turn.w(), turn.x(), turn.y(), turn.z()));
+    const Eigen::Quaterniond q2 = turn * qb;
+    const Pose pb(at + 0.2 * f + s * n, Eigen::Vector4d(q2.w(), q2.x(), q2.y(), q2.z()));
+    const Proximity p = proximity(stick, pa, stick, pb);
+    const SignedDistance sd = signed_distance(stick, pa, stick, pb);
+    EXPECT_LE((p.normal - n).norm(), 1e-14) << "s = " << s;
+    EXPECT_LE((sd.normal - n).norm(), 1e-14) << "s = " << s;
+    EXPECT_LE((sd.gradient.segment<3>(7) - n).norm(), 1e-14) << "s = " << s;
+
+    // A capsule through a unit square's face, tilted by t off the normal: the facet of the
+    // capsule's axis and a square edge, or the face; its normal is exact.
+    const double t = std::pow(10.0, -9.0 - (i % 3));
+    const PaddedPolygon plate = square(1.0, 0.1);
+    const Pose upright(Eigen::Vector3d(0.3, 0.2, 0.0),
+                       about(-M_PI / 2 + t, 0, 1, 0));  // axis along z, tilted in x-z
+    const SignedDistance through = signed_distance(plate, Pose(), stick, upright);
+    const SignedDistance reference_face =
+        signed_distance(plate, Pose(), stick, Pose(upright.r(), about(-M_PI / 2, 0, 1, 0)));
+    EXPECT_TRUE(through.penetrating);
+    EXPECT_LE(std::abs(through.normal.norm() - 1.0), 1e-15);
+    // The nearest facet is the square's edge x = 1 against the axis (0.7 to go) or the face; either
+    // way its normal lies in the x-z plane, with no y part beyond rounding.
+    EXPECT_LE(std::abs(through.normal.y()), 1e-15) << "t = " << t;
+    EXPECT_NEAR(through.distance, reference_face.distance, 1e-6);
+  }
+}
+
 // Continuity across touching: a capsule moved down through a plate, the signed distance falls
 // linearly, with slope -1, before and after its end touches the face.
 TEST(SignedDistance, ContinuousAcrossTouching) {

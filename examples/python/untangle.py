@@ -103,16 +103,18 @@ def descend(groups, r0, q0, kind):
     r = torch.tensor(r0, requires_grad=True)
     q = torch.tensor(q0, requires_grad=True)
     optimizer = torch.optim.Adam([r, q], lr=0.005)
-    for step in range(STEPS):
+    steps = 0
+    while steps < STEPS:
         optimizer.zero_grad()
         distance, _ = measure(groups, r, q, kind)
         if distance.min().item() >= 0.0:
             break
         torch.relu(MARGIN - distance).pow(2).sum().backward()
         optimizer.step()
+        steps += 1
     with torch.no_grad():
         distance, crossing = measure(groups, r, q)  # judged by the signed distance in both runs
-    return r.detach().numpy(), q.detach().numpy(), distance.numpy(), crossing.numpy(), step
+    return r.detach().numpy(), q.detach().numpy(), distance.numpy(), crossing.numpy(), steps
 
 
 def rotation(q):

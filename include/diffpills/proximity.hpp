@@ -58,6 +58,11 @@
 //     digits to subnormals and below ~1e-162 it underflows to 0 for shapes that are apart
 //     (cores_intersect stays false; the points, the gradient and the signed distance, lengths,
 //     stay exact down to ~1e-290). The normal is unit to rounding at every scale.
+//   - The normal (p2 - p1) / |p2 - p1| is taken from the closest features where they fix it: a
+//     polygon's face normal when a point lies inside a face, e x f for two edges (or segments)
+//     crossing. It then stays exact to a few ulps as the shapes approach touching, where the
+//     direction of p2 - p1 itself is known only to ~1e-16 of the scene over |p2 - p1|
+//     (src/proximity/contact_normal.hpp).
 //
 // Errors: shapes and poses validate on construction (std::invalid_argument). The default method
 // never fails on valid shapes. The interior-point reference can: on badly scaled pairs (a core

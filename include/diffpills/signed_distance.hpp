@@ -15,7 +15,8 @@
 // points whenever the cores are apart.
 //
 // Points, normal. normal is unit, from shape 1 to shape 2: (p2 - p1) / |p2 - p1| apart, the
-// outward normal of D's nearest facet in penetration. core_points = {x1, x2} on the cores with
+// outward normal of D's nearest facet in penetration; from the features (a face's normal, e x f
+// of two edges) wherever they fix it, so that it is exact also near touching (proximity.hpp). core_points = {x1, x2} on the cores with
 // x2 - x1 = s * normal (apart: the closest points; in penetration: the deepest points of the two
 // cores along the normal), points = {x1 + R1 normal, x2 - R2 normal} on the surfaces, so that
 // points[1] - points[0] = distance * normal. Where those points are not unique, the middle of the

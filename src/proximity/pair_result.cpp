@@ -1,5 +1,6 @@
 #include "pair_result.hpp"
 
+#include "contact_normal.hpp"
 #include "point_motion.hpp"
 
 namespace diffpills::detail {
@@ -54,8 +55,9 @@ Proximity make_proximity(const PairFrame& frame, const Pose& pose_a, const Posed
 
   const NormalRule rule = normal_rule(frame, a, b, p1, p2);
   switch (rule) {
-    case NormalRule::kClosestPoints:
-      result.normal = difference * (-1.0 / difference.norm());  // one division, not three
+    case NormalRule::kClosestPoints:  // from the features where they fix it (contact_normal.hpp)
+      result.normal =
+          source_normal(points_normal_source(a, side_a, b, side_b, -difference), a, b, -difference);
       break;
     case NormalRule::kOrigins:
       result.normal = (b.r - a.r).normalized();
@@ -95,7 +97,8 @@ ProximityJacobian make_proximity_jacobian(const PairFrame& frame, const Pose& po
   Matrix3x14 dnormal = Matrix3x14::Zero();
   switch (normal_rule(frame, a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
-      dnormal = unit_vector_motion(p2 - p1, motion.dp2 - motion.dp1);
+      dnormal = source_normal_motion(points_normal_source(a, side_a, b, side_b, p2 - p1), a, b,
+                                     p2 - p1, motion);
       break;
     case NormalRule::kOrigins: {
       Matrix3x14 d_origins = Matrix3x14::Zero();  // d(r2 - r1)

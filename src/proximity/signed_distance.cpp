@@ -93,7 +93,9 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   const double apart = (x2 - x1).norm();
   if (apart > frame.tolerance) {
     solution.gap = apart;
-    solution.normal = (x2 - x1) / apart;
+    solution.source =
+        detail::points_normal_source(pa, solution.sides[0], pb, solution.sides[1], x2 - x1);
+    solution.normal = detail::source_normal(solution.source, pa, pb, x2 - x1);
     return solution;
   }
   const std::optional<PolygonView> view_a = polygon_view(a, frame);
@@ -109,6 +111,14 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   }
   solution.gap = -facet.depth;
   solution.normal = facet.normal;
+  // An edge pair's normal from e x f where that is the better conditioned, as for the closest
+  // points (contact_normal.hpp); the search took it from the witnesses (penetration.hpp).
+  if (facet.kind == DeepestFacet::Kind::kEdges &&
+      detail::stable_cross(outline_a.edge(facet.edges[0]).direction,
+                           outline_b.edge(facet.edges[1]).direction)
+              .norm() >= facet.depth) {
+    solution.normal = detail::source_normal(solution.source, pa, pb, facet.normal);
+  }
   // Touching, or a flat D, leave the closest points as they are (the middle of the cores'
   // intersection), as does the search's fallback (penetration.hpp).
   if (facet.witnesses) solution.sides = *facet.witnesses;

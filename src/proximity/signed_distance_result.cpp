@@ -2,25 +2,9 @@
 
 #include <Eigen/Geometry>
 
-#include "penetration.hpp"
 #include "point_motion.hpp"
-#include "unit_quaternion.hpp"
 
 namespace diffpills::detail {
-namespace {
-
-// d(sign * unit(a x b)) with a = Q1 u, b = Q2 v: d(a x b) = da x b + a x db = -[b]x da + [a]x db.
-Matrix3x14 edge_normal_motion(const PosedCore& a, const PosedCore& b, const NormalSource& source) {
-  const Eigen::Vector3d edge_a = a.attitude.matrix() * source.edge_directions[0];
-  const Eigen::Vector3d edge_b = b.attitude.matrix() * source.edge_directions[1];
-  Matrix3x14 d_cross = Matrix3x14::Zero();
-  d_cross.middleCols<4>(3) = -skew(edge_b) * a.attitude.rotate_jacobian(source.edge_directions[0]);
-  d_cross.middleCols<4>(10) = skew(edge_a) * b.attitude.rotate_jacobian(source.edge_directions[1]);
-  return source.sign * unit_vector_motion(stable_cross(edge_a, edge_b), d_cross);
-}
-
-}  // namespace
-
 SignedDistance make_signed_distance(const PairFrame& frame, const Pose& pose_a, const PosedCore& a,
                                     const Pose& pose_b, const PosedCore& b,
                                     const SignedSolution& solution) {
@@ -58,23 +42,7 @@ SignedDistanceJacobian make_signed_distance_jacobian(const PairFrame& frame, con
   const Eigen::Vector3d x2 = b.r + b.attitude.matrix() * side_b.body_point;
   const PointMotion motion = core_point_motion(a, side_a, b, side_b);
 
-  Matrix3x14 dnormal = Matrix3x14::Zero();
-  switch (solution.source.kind) {
-    case NormalSource::Kind::kClosestPoints:
-      dnormal = unit_vector_motion(x2 - x1, motion.dp2 - motion.dp1);
-      break;
-    case NormalSource::Kind::kFace: {
-      const PosedCore& face = solution.source.face_core == 0 ? a : b;
-      dnormal.middleCols<4>(solution.source.face_core == 0 ? 3 : 10) =
-          solution.source.sign * face.attitude.rotate_jacobian(Eigen::Vector3d::UnitZ());
-      break;
-    }
-    case NormalSource::Kind::kEdges:
-      dnormal = edge_normal_motion(a, b, solution.source);
-      break;
-    case NormalSource::Kind::kFixed:
-      break;
-  }
+  const Matrix3x14 dnormal = source_normal_motion(solution.source, a, b, x2 - x1, motion);
   point_jacobians(frame.scale, a, b, motion, dnormal, result.core_points_jacobian,
                   result.points_jacobian);
   return result;

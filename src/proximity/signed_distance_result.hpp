@@ -7,25 +7,12 @@
 
 #include <array>
 
+#include "contact_normal.hpp"
 #include "diffpills/signed_distance.hpp"
 #include "pair_frame.hpp"
 #include "posed_core.hpp"
 
 namespace diffpills::detail {
-
-// How the normal moves with the poses: it is the closest points' direction (apart), the normal
-// of a polygon's face or of two edges (a facet of D, penetration.hpp), or a fixed choice (flat D
-// without a facet: parallel segments, spheres).
-struct NormalSource {
-  enum class Kind { kClosestPoints, kFace, kEdges, kFixed };
-  Kind kind = Kind::kClosestPoints;
-  int face_core = 0;  // kFace: normal = sign * Q_face_core e_z
-  double sign = 1.0;  // kFace, kEdges
-  // kEdges: the edges' unit directions in their bodies' frames; normal = sign * unit(a x b) with
-  // a = Q1 edge_directions[0], b = Q2 edge_directions[1].
-  std::array<Eigen::Vector3d, 2> edge_directions = {Eigen::Vector3d::Zero(),
-                                                    Eigen::Vector3d::Zero()};
-};
 
 // The pair's answer in the frame: the two sides, s (|x2 - x1| apart, minus the depth in
 // penetration) and the unit normal with its source.
