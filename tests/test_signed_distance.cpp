@@ -575,6 +575,33 @@ TEST(SignedDistance, NormalsNearTouchingComeFromTheFeatures) {
   }
 }
 
+// A polygon 1e-300 wide against one 1e70 wide (found by fuzz_proximity): in the pair's frame the
+// small one is a point whose edges have zero length, and its closest point, labelled inside a
+// face or an edge, fixes no normal. The normal must still be the direction between the points.
+TEST(SignedDistance, FeatureNormalsAgreeWithThePoints) {
+  const auto regular = [](double offset, double radius) {
+    Eigen::MatrixX2d C(51, 2);
+    for (int k = 0; k < 51; ++k)
+      C.row(k) << std::cos(2 * M_PI * k / 51), std::sin(2 * M_PI * k / 51);
+    return PaddedPolygon(C, Eigen::VectorXd::Constant(51, offset), radius);
+  };
+  const double big = 1.0352619520185846e+70;
+  const PaddedPolygon a = regular(big, 8.8162076311671563e-39);
+  const PaddedPolygon b = regular(3.5093507569358994e-300, 9.1949732451953332e+54);
+  const Pose pa(Eigen::Vector3d(2.875, big, big),
+                Eigen::Vector4d(big, big, big, 4.043992000072596e+67));
+  const Pose pb(Eigen::Vector3d(1.3980656882659035e-76, 1.3980432860952889e-76, 16.188235294117646),
+                Eigen::Vector4d(big, 0, 0, 0));
+  for (const bool swap : {false, true}) {
+    const SignedDistance sd = swap ? signed_distance(b, pb, a, pa) : signed_distance(a, pa, b, pb);
+    const Proximity p = swap ? proximity(b, pb, a, pa) : proximity(a, pa, b, pb);
+    const Eigen::Vector3d along = (sd.core_points[1] - sd.core_points[0]).normalized();
+    EXPECT_LE((sd.normal - along).norm(), 1e-12) << swap;
+    EXPECT_LE((p.normal - along).norm(), 1e-12) << swap;
+    EXPECT_LE((sd.points[1] - sd.points[0] - sd.distance * sd.normal).norm(), 1e-10 * big);
+  }
+}
+
 // Continuity across touching: a capsule moved down through a plate, the signed distance falls
 // linearly, with slope -1, before and after its end touches the face.
 TEST(SignedDistance, ContinuousAcrossTouching) {

@@ -14,7 +14,10 @@
 //     is the smaller error, |sin| >= |d| (in the frame's units, where the scene's size is in
 //     [1, 2)).
 // Otherwise (a vertex or a segment's end on either side, or edges too close to parallel) d / |d|
-// is what there is: the problem itself is then that ill-conditioned. The sign follows d.
+// is what there is: the problem itself is then that ill-conditioned. The sign follows d, and a
+// feature's normal is taken only if it agrees with d / |d| to d's own uncertainty: one that does
+// not means the features' labels are off (a zero-length segment, a point at an edge's end
+// labelled inside it by rounding).
 #pragma once
 
 #include <Eigen/Core>

@@ -117,7 +117,11 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
       detail::stable_cross(outline_a.edge(facet.edges[0]).direction,
                            outline_b.edge(facet.edges[1]).direction)
               .norm() >= facet.depth) {
-    solution.normal = detail::source_normal(solution.source, pa, pb, facet.normal);
+    const Eigen::Vector3d crossed = detail::source_normal(solution.source, pa, pb, facet.normal);
+    // (Only if it agrees with the witnesses' direction to that direction's uncertainty.)
+    if ((crossed - facet.normal).norm() <= 1e-12 * (1.0 + 1.0 / facet.depth)) {
+      solution.normal = crossed;
+    }
   }
   // Touching, or a flat D, leave the closest points as they are (the middle of the cores'
   // intersection), as does the search's fallback (penetration.hpp).
