@@ -46,7 +46,8 @@ fuzz-build: deps
 fuzz: fuzz-build
 	bash scripts/run-fuzzers.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
 
-# The motion-planning demo (car-bus and quadrotor-window problems: out/*.csv, *.json, *.svg), then
+# The motion-planning demo (car-bus, quadrotor-window and arm-shelf problems: out/*.csv, *.json,
+# *.svg), then
 # the Python example that untangles a 3-D heap of crossing shapes with the signed distance
 # (out/untangle_{before,after}.png).
 demo: build

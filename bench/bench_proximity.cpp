@@ -16,9 +16,11 @@
 #include <random>
 #include <vector>
 
+#include "arm_shelf/arm_shelf.hpp"
 #include "car_bus/car_bus.hpp"
 #include "car_bus/car_bus_ipopt.hpp"
 #include "diffpills/diffpills.hpp"
+#include "ipopt/problem_nlp.hpp"
 #include "quadrotor_window/quadrotor_window.hpp"
 
 namespace {
@@ -401,9 +403,29 @@ void QuadrotorWindow_Altro(benchmark::State& state) {
     benchmark::DoNotOptimize(trajopt::solve(problem, problem.scenario().x0, guess));
   }
 }
+// The arm among the shelves (issue 11, target < 1 s): 7 joints, 41 knots, 85 shape pairs checked at
+// 4 points of every step through the scene query.
+void ArmShelf_Altro(benchmark::State& state) {
+  const examples::ArmShelfProblem problem{examples::ArmShelfScenario{}};
+  const std::vector<Eigen::VectorXd> guess = problem.retreat_controls();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(trajopt::solve(problem, problem.scenario().start, guess,
+                                            examples::ArmShelfProblem::settings()));
+  }
+}
+void ArmShelf_Ipopt(benchmark::State& state) {
+  const examples::ArmShelfProblem problem{examples::ArmShelfScenario{}};
+  const std::vector<Eigen::VectorXd> guess = problem.retreat_controls();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        examples::solve_problem_with_ipopt(problem, problem.scenario().start, guess).cost);
+  }
+}
 BENCHMARK(CarBus_Altro)->Unit(benchmark::kMillisecond);
 BENCHMARK(QuadrotorWindow_Altro)->Unit(benchmark::kMillisecond);
+BENCHMARK(ArmShelf_Altro)->Unit(benchmark::kMillisecond);
 BENCHMARK(CarBus_Ipopt)->Unit(benchmark::kMillisecond);
+BENCHMARK(ArmShelf_Ipopt)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 BENCHMARK(CapsuleCapsule_FclDistance);
 BENCHMARK(CapsuleCapsule_Proximity);

@@ -1,7 +1,8 @@
-// `make demo`'s files parse and carry what the motion-planning issue promises: runs the demo
+// `make demo`'s files parse and carry what the motion-planning issues promise: runs the demo
 // program (its path is the first argument) into a fresh folder and reads everything back, then
 // checks that each CSV row follows from the previous one by RK4 of the documented model, with the
-// parameters the JSON files state.
+// parameters the JSON files state; and the arm's motion from the JSON's own description alone
+// (its DH parameters, links, exclusions and shelf): limits, start, goal and the signed distances.
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -14,6 +15,9 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "diffpills/diffpills.hpp"
+#include "json_io.hpp"
 
 namespace {
 
@@ -171,6 +175,100 @@ TEST(DemoOutputs, FilesParseAndCarryTheScenario) {
     EXPECT_EQ(svg.rfind("<svg", 0), 0u) << figure;
     EXPECT_NE(svg.find("</svg>"), std::string::npos) << figure;
   }
+}
+
+// The arm: every row of arm_shelf.csv posed by the modified-DH product of the JSON's parameters,
+// T_i = RotX(alpha_i) TransX(a_i) RotZ(q_i) TransZ(d_i), its links' shapes placed by it, and every
+// pair of non-excluded links and of a moving link and a board measured with signed_distance().
+TEST(DemoOutputs, ArmShelfFromItsOwnDescription) {
+  const std::filesystem::path& out = demo_folder();
+  const nlohmann::json arm = nlohmann::json::parse(read(out / "arm_shelf.json"));
+  EXPECT_EQ(read(out / "arm_shelf.csv").substr(0, 23), "t,q1,q2,q3,q4,q5,q6,q7\n");
+  const std::vector<Eigen::VectorXd> rows = csv_rows(out / "arm_shelf.csv");
+  ASSERT_EQ(rows.size(), arm["knots"].get<std::size_t>());
+  EXPECT_EQ(arm["status"], "solved");
+  EXPECT_GT(arm["iterations"].get<int>(), 0);
+  EXPECT_GT(arm["ms"].get<double>(), 0.0);
+  for (const char* key : {"a", "d", "alpha"}) ASSERT_EQ(arm["dh"][key].size(), 7u) << key;
+  ASSERT_EQ(arm["joint_limits"].size(), 7u);
+  ASSERT_EQ(arm["links"].size(), 9u);
+  ASSERT_EQ(arm["start"].size(), 7u);
+  ASSERT_EQ(arm["goal"].size(), 7u);
+
+  struct Placed {
+    int frame;
+    diffpills::Shape shape;
+    diffpills::Pose local;
+  };
+  std::vector<Placed> links;
+  for (const auto& link : arm["links"]) {
+    for (const auto& shape : link["shapes"]) {
+      const diffpills::app::PosedShape posed = diffpills::app::parse_posed_shape(shape, "shape");
+      links.push_back({link["frame"].get<int>(), posed.shape, posed.pose});
+    }
+  }
+  std::vector<diffpills::app::PosedShape> boards;
+  for (const auto& body : arm["shelf"]["bodies"]) {
+    for (const auto& shape : body["shapes"]) {
+      boards.push_back(diffpills::app::parse_posed_shape(shape, "board"));
+    }
+  }
+  const auto excluded = [&](int f, int g) {
+    for (const auto& pair : arm["excluded_link_pairs"]) {
+      if ((pair[0] == f && pair[1] == g) || (pair[0] == g && pair[1] == f)) return true;
+    }
+    return f == g;
+  };
+  const double dt = arm["dt"].get<double>();
+  double smallest = INFINITY;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const Eigen::VectorXd& row = rows[k];
+    EXPECT_NEAR(row(0), dt * static_cast<double>(k), 1e-12);
+    const Eigen::VectorXd q = row.tail(7);
+    for (int i = 0; i < 7; ++i) {
+      EXPECT_GE(q(i), arm["joint_limits"][i][0].get<double>() - 1e-6);
+      EXPECT_LE(q(i), arm["joint_limits"][i][1].get<double>() + 1e-6);
+      if (k == 0) EXPECT_NEAR(q(i), arm["start"][i].get<double>(), 1e-9);
+      if (k + 1 == rows.size()) EXPECT_NEAR(q(i), arm["goal"][i].get<double>(), 1e-6);
+    }
+    std::vector<Eigen::Isometry3d> frames{Eigen::Isometry3d::Identity()};
+    for (int i = 0; i < 7; ++i) {
+      Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+      step.rotate(Eigen::AngleAxisd(arm["dh"]["alpha"][i].get<double>(), Eigen::Vector3d::UnitX()));
+      step.translate(Eigen::Vector3d(arm["dh"]["a"][i].get<double>(), 0, 0));
+      step.rotate(Eigen::AngleAxisd(q(i), Eigen::Vector3d::UnitZ()));
+      step.translate(Eigen::Vector3d(0, 0, arm["dh"]["d"][i].get<double>()));
+      frames.push_back(frames.back() * step);
+    }
+    frames.push_back(frames.back() * Eigen::Translation3d(0, 0, arm["flange_d"].get<double>()));
+    std::vector<diffpills::Pose> world;
+    for (const Placed& link : links) {
+      const Eigen::Isometry3d& T = frames[static_cast<std::size_t>(link.frame)];
+      const Eigen::Quaterniond q_world = Eigen::Quaterniond(T.rotation()) *
+                                         Eigen::Quaterniond(link.local.q()(0), link.local.q()(1),
+                                                            link.local.q()(2), link.local.q()(3));
+      world.emplace_back(T * link.local.r(),
+                         Eigen::Vector4d(q_world.w(), q_world.x(), q_world.y(), q_world.z()));
+    }
+    for (std::size_t i = 0; i < links.size(); ++i) {
+      for (std::size_t j = i + 1; j < links.size(); ++j) {
+        if (excluded(links[i].frame, links[j].frame)) continue;
+        smallest = std::min(
+            smallest, diffpills::signed_distance(links[i].shape, world[i], links[j].shape, world[j])
+                          .distance);
+      }
+      if (links[i].frame == 0) continue;  // the base never moves
+      for (const auto& board : boards) {
+        smallest = std::min(
+            smallest,
+            diffpills::signed_distance(links[i].shape, world[i], board.shape, board.pose).distance);
+      }
+    }
+  }
+  EXPECT_GE(smallest, arm["clearance"].get<double>() - 1e-6);
+  EXPECT_NEAR(smallest, arm["min_distance"].get<double>(), 1e-9);
+  EXPECT_LT(arm["straight_line_min_distance"].get<double>(), 0.0);
+  EXPECT_EQ(read(out / "arm_shelf.svg").rfind("<svg", 0), 0u);
 }
 
 }  // namespace

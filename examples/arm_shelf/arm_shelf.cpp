@@ -1,0 +1,295 @@
+#include "arm_shelf.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace diffpills::examples {
+namespace {
+
+// Local attitudes: a capsule's axis (body x) along its frame's z, or its y; a polygon's plane
+// (body x-y) on its frame's y-z plane (x to y, y to z), or a board's on the world's x-z plane.
+// (Functions, not globals: a static initializer elsewhere may build a scenario first.)
+Eigen::Vector4d identity() { return {1, 0, 0, 0}; }
+Eigen::Vector4d x_to_z() { return {std::sqrt(0.5), 0, -std::sqrt(0.5), 0}; }  // -90 deg about y
+Eigen::Vector4d x_to_y() { return {std::sqrt(0.5), 0, 0, std::sqrt(0.5)}; }   // 90 deg about z
+Eigen::Vector4d xy_to_yz() { return {0.5, 0.5, 0.5, 0.5}; }  // x to y, y to z, z to x
+Eigen::Vector4d xy_to_xz() { return {std::sqrt(0.5), std::sqrt(0.5), 0, 0}; }  // 90 deg about x
+
+BodyShape capsule(double length, double radius, const Eigen::Vector3d& centre,
+                  const Eigen::Vector4d& attitude) {
+  return {Capsule(length, radius), Pose(centre, attitude)};
+}
+
+// A rectangle of half-sides (hx, hy) in its body x-y plane, padded by `radius`.
+PaddedPolygon rectangle(double hx, double hy, double radius) {
+  Eigen::MatrixX2d C(4, 2);
+  C << 1, 0, 0, 1, -1, 0, 0, -1;
+  return PaddedPolygon(C, Eigen::Vector4d(hx, hy, hx, hy), radius);
+}
+
+Body board(const std::string& name, const Eigen::Vector3d& centre, double h1, double h2,
+           const Eigen::Vector4d& attitude) {
+  return Body(name, {{rectangle(h1, h2, 0.01), Pose(centre, attitude)}}, CollisionFilter{2, ~2u});
+}
+
+constexpr int kLinks = 9;  // frames 0 .. 8
+
+}  // namespace
+
+PandaArm panda_arm() {
+  PandaArm arm;
+  arm.chain.a = {0, 0, 0, 0.0825, -0.0825, 0, 0.088};
+  arm.chain.d = {0.333, 0, 0.316, 0, 0.384, 0, 0};
+  arm.chain.alpha = {0, -M_PI / 2, M_PI / 2, M_PI / 2, -M_PI / 2, M_PI / 2, M_PI / 2};
+  arm.chain.flange_d = 0.107;
+  arm.joint_limits << -2.8973, 2.8973, -1.7628, 1.7628, -2.8973, 2.8973, -3.0718, -0.0698, -2.8973,
+      2.8973, -0.0175, 3.7525, -2.8973, 2.8973;
+  arm.velocity_limits << 2.1750, 2.1750, 2.1750, 2.1750, 2.6100, 2.6100, 2.6100;
+  arm.links = {
+      {capsule(0.14, 0.10, {0, 0, 0.07}, x_to_z())},         // base column, up to 0.14 m
+      {capsule(0.19, 0.08, {0, 0, -0.095}, x_to_z())},       // shoulder, from the column to joint 2
+      {capsule(0.27, 0.08, {0, -0.135, 0}, x_to_y())},       // upper arm, along frame 2's -y
+      {capsule(0.10, 0.07, {0, 0, -0.05}, x_to_z()),         // joint 3's housing
+       capsule(0.0825, 0.07, {0.04125, 0, 0}, identity())},  // to the elbow
+      {capsule(0.0825, 0.07, {-0.04125, 0, 0}, identity())},  // elbow
+      {capsule(0.22, 0.06, {0, 0, -0.19}, x_to_z())},         // forearm, along frame 5's z
+      {capsule(0.088, 0.06, {0.044, 0, 0}, identity())},      // wrist
+      {capsule(0.107, 0.05, {0, 0, 0.0535}, x_to_z())},       // flange
+      {{rectangle(0.1, 0.05, 0.02), Pose(Eigen::Vector3d(0, 0, 0.05), xy_to_yz())}},  // hand
+  };
+  for (int f = 0; f + 1 < kLinks; ++f) arm.excluded_link_pairs.emplace_back(f, f + 1);
+  arm.excluded_link_pairs.emplace_back(2, 4);
+  arm.excluded_link_pairs.emplace_back(3, 5);
+  arm.excluded_link_pairs.emplace_back(5, 7);
+  return arm;
+}
+
+ArmShelfScenario::ArmShelfScenario() {
+  const double x = 0.60, half_x = 0.20, half_y = 0.45;
+  const double bottom = 0.55, top = 0.87, middle = 0.5 * (bottom + top),
+               half_z = 0.5 * (top - bottom);
+  shelf = {board("bottom", {x, 0, bottom}, half_x, half_y, identity()),
+           board("top", {x, 0, top}, half_x, half_y, identity()),
+           board("divider", {x, 0, middle}, half_x, half_z, xy_to_xz()),
+           board("left", {x, half_y, middle}, half_x, half_z, xy_to_xz()),
+           board("right", {x, -half_y, middle}, half_x, half_z, xy_to_xz()),
+           board("back", {x + half_x, 0, middle}, half_y, half_z, xy_to_yz())};
+  // Joint 1 turned by +-atan(0.22 / 0.52) = +-0.40024: the arm's plane through the middle of
+  // either compartment, the hand pointing along it.
+  const double yaw = std::atan2(0.22, 0.52);
+  start << yaw, -0.055128, 0, -1.814802, 0, 3.33047, 0;
+  goal << -yaw, -0.055128, 0, -1.814802, 0, 3.33047, 0;
+  retract_left << yaw, -1.028344, 0, -2.565911, 0, 3.108363, 0;
+  retract_right << -yaw, -1.028344, 0, -2.565911, 0, 3.108363, 0;
+}
+
+Scene arm_shelf_scene(const ArmShelfScenario& scenario) {
+  std::vector<Body> bodies;
+  bodies.reserve(kLinks + scenario.shelf.size());
+  for (int f = 0; f < kLinks; ++f) {
+    bodies.emplace_back("link" + std::to_string(f),
+                        scenario.arm.links[static_cast<std::size_t>(f)]);
+  }
+  for (const Body& board : scenario.shelf) bodies.push_back(board);
+  std::vector<std::pair<std::string, std::string>> exclude;
+  for (const auto& [f, g] : scenario.arm.excluded_link_pairs) {
+    exclude.emplace_back("link" + std::to_string(f), "link" + std::to_string(g));
+  }
+  return Scene(std::move(bodies), exclude);
+}
+
+std::vector<Pose> arm_shelf_poses(const ArmShelfScenario& scenario, const Eigen::VectorXd& q,
+                                  trajopt::ChainFrames* frames) {
+  trajopt::ChainFrames chain =
+      trajopt::forward_kinematics(scenario.arm.chain, q, frames != nullptr);
+  std::vector<Pose> poses;
+  poses.reserve(kLinks + scenario.shelf.size());
+  for (int f = 0; f < kLinks; ++f) {
+    poses.emplace_back(chain.origin[static_cast<std::size_t>(f)],
+                       chain.attitude[static_cast<std::size_t>(f)]);
+  }
+  poses.resize(poses.size() + scenario.shelf.size());
+  if (frames != nullptr) *frames = std::move(chain);
+  return poses;
+}
+
+ArmShelfProblem::ArmShelfProblem(ArmShelfScenario scenario)
+    : scenario_(std::move(scenario)), scene_(arm_shelf_scene(scenario_)) {
+  // One row per pair of shapes of two checked bodies of which at least one moves (link1 ..
+  // link8): the base and the boards never move relative to each other.
+  const auto moves = [](int body) { return body >= 1 && body < kLinks; };
+  for (int i = 0; i < scene_.size(); ++i) {
+    for (int j = i + 1; j < scene_.size(); ++j) {
+      if (!scene_.checked(i, j) || (!moves(i) && !moves(j))) continue;
+      for (int a = 0; a < static_cast<int>(scene_.body(i).shapes().size()); ++a) {
+        for (int b = 0; b < static_cast<int>(scene_.body(j).shapes().size()); ++b) {
+          row_of_[{i, j, a, b}] = static_cast<int>(pairs_.size());
+          pairs_.push_back({i, j, a, b});
+        }
+      }
+    }
+  }
+}
+
+void ArmShelfProblem::dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                               Eigen::VectorXd& next, Eigen::MatrixXd& A,
+                               Eigen::MatrixXd& B) const {
+  next = x + scenario_.dt * u;
+  A = Eigen::MatrixXd::Identity(7, 7);
+  B = scenario_.dt * Eigen::MatrixXd::Identity(7, 7);
+}
+
+trajopt::CostExpansion ArmShelfProblem::stage_cost(int, const Eigen::VectorXd&,
+                                                   const Eigen::VectorXd& u) const {
+  trajopt::CostExpansion cost;
+  cost.value = 0.5 * scenario_.dt * u.squaredNorm();
+  cost.x = Eigen::VectorXd::Zero(7);
+  cost.u = scenario_.dt * u;
+  cost.xx = Eigen::MatrixXd::Zero(7, 7);
+  cost.uu = scenario_.dt * Eigen::MatrixXd::Identity(7, 7);
+  cost.ux = Eigen::MatrixXd::Zero(7, 7);
+  return cost;
+}
+
+trajopt::CostExpansion ArmShelfProblem::terminal_cost(const Eigen::VectorXd&) const {
+  trajopt::CostExpansion cost;
+  cost.x = Eigen::VectorXd::Zero(7);
+  cost.xx = Eigen::MatrixXd::Zero(7, 7);
+  return cost;
+}
+
+trajopt::KnotConstraints ArmShelfProblem::constraints(int k, const Eigen::VectorXd& x,
+                                                      const Eigen::VectorXd& u) const {
+  return evaluate(k, x, u, true);
+}
+
+trajopt::KnotConstraints ArmShelfProblem::constraint_values(int k, const Eigen::VectorXd& x,
+                                                            const Eigen::VectorXd& u) const {
+  return evaluate(k, x, u, false);
+}
+
+trajopt::KnotConstraints ArmShelfProblem::evaluate(int k, const Eigen::VectorXd& x,
+                                                   const Eigen::VectorXd& u,
+                                                   bool derivatives) const {
+  const bool last = k == knots() - 1;
+  const int goal_rows = last ? 7 : 0, limit_rows = 14, velocity_rows = last ? 0 : 14;
+  const int collision_start = goal_rows + limit_rows + velocity_rows;
+  const int rows =
+      collision_start + (last ? 1 : scenario_.substeps) * static_cast<int>(pairs_.size());
+  trajopt::KnotConstraints out;
+  out.equalities = goal_rows;
+  out.value.resize(rows);
+  if (derivatives) {
+    out.dx = Eigen::MatrixXd::Zero(rows, 7);
+    out.du = Eigen::MatrixXd::Zero(rows, last ? 0 : 7);
+  }
+  const auto& limits = scenario_.arm.joint_limits;
+  if (last) {
+    out.value.head(7) = x - scenario_.goal;
+    if (derivatives) out.dx.topRows(7).setIdentity();
+  }
+  out.value.segment(goal_rows, 7) = x - limits.col(1);
+  out.value.segment(goal_rows + 7, 7) = limits.col(0) - x;
+  if (derivatives) {
+    out.dx.block(goal_rows, 0, 7, 7).setIdentity();
+    out.dx.block(goal_rows + 7, 0, 7, 7) = -Eigen::MatrixXd::Identity(7, 7);
+  }
+  if (!last) {
+    const int v = goal_rows + limit_rows;
+    out.value.segment(v, 7) = u - scenario_.arm.velocity_limits;
+    out.value.segment(v + 7, 7) = -scenario_.arm.velocity_limits - u;
+    if (derivatives) {
+      out.du.block(v, 0, 7, 7).setIdentity();
+      out.du.block(v + 7, 0, 7, 7) = -Eigen::MatrixXd::Identity(7, 7);
+    }
+  }
+  // Collision rows: clearance - min(distance, margin), at the knot and at the substeps between it
+  // and the next knot, q = x + (s / S) dt u. Pairs the query does not report are more than the
+  // margin apart: their row is the constant clearance - margin.
+  const auto pair_count = static_cast<Eigen::Index>(pairs_.size());
+  out.value.tail(rows - collision_start).setConstant(scenario_.clearance - scenario_.query_margin);
+  const int substeps = last ? 1 : scenario_.substeps;
+  for (int step = 0; step < substeps; ++step) {
+    const double fraction = static_cast<double>(step) / scenario_.substeps;
+    const Eigen::VectorXd q = last ? x : Eigen::VectorXd(x + fraction * scenario_.dt * u);
+    trajopt::ChainFrames frames;
+    const std::vector<Pose> poses = arm_shelf_poses(scenario_, q, derivatives ? &frames : nullptr);
+    const Eigen::Index first_row = collision_start + step * pair_count;
+    for (const Contact& contact : scene_.contacts(poses, scenario_.query_margin)) {
+      const auto found = row_of_.find(
+          {contact.bodies[0], contact.bodies[1], contact.shapes[0], contact.shapes[1]});
+      if (found == row_of_.end()) continue;  // two bodies that never move
+      const Eigen::Index row = first_row + found->second;
+      out.value(row) = scenario_.clearance - std::min(contact.distance, scenario_.query_margin);
+      if (!derivatives || contact.distance >= scenario_.query_margin) continue;
+      // d distance / dq through the two bodies' frames (the boards and the base do not move),
+      // then dq/dx = I and dq/du = (s / S) dt.
+      Eigen::RowVectorXd dq = Eigen::RowVectorXd::Zero(7);
+      for (int side = 0; side < 2; ++side) {
+        const int body = contact.bodies[static_cast<std::size_t>(side)];
+        if (body < 1 || body >= kLinks) continue;
+        const auto f = static_cast<std::size_t>(body);
+        const auto g = contact.gradient.segment<7>(Eigen::Index{7} * side);
+        dq -= g.head<3>().transpose() * frames.d_origin[f] +
+              g.tail<4>().transpose() * frames.d_attitude[f];
+      }
+      out.dx.row(row) = dq;
+      if (!last) out.du.row(row) = fraction * scenario_.dt * dq;
+    }
+  }
+  return out;
+}
+
+std::vector<Eigen::VectorXd> ArmShelfProblem::straight_line_controls() const {
+  const Eigen::VectorXd velocity =
+      (scenario_.goal - scenario_.start) / (scenario_.dt * (scenario_.knots - 1));
+  return std::vector<Eigen::VectorXd>(static_cast<std::size_t>(scenario_.knots - 1), velocity);
+}
+
+trajopt::AltroSettings ArmShelfProblem::settings() {
+  trajopt::AltroSettings settings;
+  settings.penalty_initial = 100.0;
+  return settings;
+}
+
+std::vector<Eigen::VectorXd> ArmShelfProblem::retreat_controls() const {
+  const int steps = scenario_.knots - 1;
+  const int out = steps / 4, across = steps - 2 * out;
+  const std::vector<std::pair<Eigen::VectorXd, int>> legs = {
+      {scenario_.retract_left - scenario_.start, out},
+      {scenario_.retract_right - scenario_.retract_left, across},
+      {scenario_.goal - scenario_.retract_right, out}};
+  std::vector<Eigen::VectorXd> controls;
+  for (const auto& [change, count] : legs) {
+    for (int i = 0; i < count; ++i) controls.emplace_back(change / (count * scenario_.dt));
+  }
+  return controls;
+}
+
+double arm_shelf_min_distance(const ArmShelfProblem& problem, const Eigen::VectorXd& q) {
+  double smallest = std::numeric_limits<double>::infinity();
+  const std::vector<Pose> poses = arm_shelf_poses(problem.scenario(), q);
+  for (const Contact& contact : problem.scene().contacts(poses, 1e3)) {
+    const bool moves = (contact.bodies[0] >= 1 && contact.bodies[0] < kLinks) ||
+                       (contact.bodies[1] >= 1 && contact.bodies[1] < kLinks);
+    if (moves) smallest = std::min(smallest, contact.distance);
+  }
+  return smallest;
+}
+
+double arm_shelf_path_min_distance(const ArmShelfProblem& problem,
+                                   const std::vector<Eigen::VectorXd>& states, int samples) {
+  double smallest = arm_shelf_min_distance(problem, states.back());
+  for (std::size_t k = 0; k + 1 < states.size(); ++k) {
+    for (int i = 0; i < samples; ++i) {
+      const double t = static_cast<double>(i) / samples;
+      smallest = std::min(
+          smallest, arm_shelf_min_distance(problem, states[k] + t * (states[k + 1] - states[k])));
+    }
+  }
+  return smallest;
+}
+
+}  // namespace diffpills::examples

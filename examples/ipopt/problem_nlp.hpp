@@ -1,0 +1,32 @@
+// Any trajopt::Problem as a nonlinear program for Ipopt, to cross-check the ALTRO solver on the
+// same discretization, costs and constraints:
+//   variables   z = [x_0 .. x_{N-1}, u_0 .. u_{N-2}]
+//   minimize    sum_k l_k(x_k, u_k) + l_N(x_{N-1})
+//   subject to  x_{k+1} - f(x_k, u_k) = 0,  e_k(x_k, u_k) = 0,  c_k(x_k, u_k) <= 0,
+//               x_0 = the given initial state (variable bounds)
+// with the problem's exact first derivatives (dense per knot) and Ipopt's limited-memory Hessian
+// approximation, started from the rollout of the initial controls, as ALTRO is.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "diffpills/trajopt/problem.hpp"
+
+namespace diffpills::examples {
+
+struct ProblemIpoptRun {
+  bool solved = false;
+  std::string status;
+  int iterations = 0;
+  double cost = 0.0;
+  double max_violation = 0.0;  // dynamics defects, |e|, positive c
+  double solve_ms = 0.0;
+  std::vector<Eigen::VectorXd> states, controls;
+};
+
+ProblemIpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
+                                         const std::vector<Eigen::VectorXd>& initial_controls);
+
+}  // namespace diffpills::examples

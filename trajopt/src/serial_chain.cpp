@@ -1,0 +1,70 @@
+#include "diffpills/trajopt/serial_chain.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <stdexcept>
+
+#include "diffpills/rotation.hpp"
+
+namespace diffpills::trajopt {
+namespace {
+
+Eigen::Vector4d about_x(double angle) {
+  return {std::cos(0.5 * angle), std::sin(0.5 * angle), 0.0, 0.0};
+}
+Eigen::Vector4d about_z(double angle) {
+  return {std::cos(0.5 * angle), 0.0, 0.0, std::sin(0.5 * angle)};
+}
+Eigen::Vector4d product(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
+  return left_multiply_matrix(a) * b;
+}
+
+}  // namespace
+
+ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::VectorXd& q,
+                               bool derivatives) {
+  const int n = chain.joints();
+  if (static_cast<int>(chain.d.size()) != n || static_cast<int>(chain.alpha.size()) != n) {
+    throw std::invalid_argument("chain: a, d and alpha must have one entry per joint");
+  }
+  if (q.size() != n) {
+    throw std::invalid_argument("q: expected " + std::to_string(n) + " joint angles, got " +
+                                std::to_string(q.size()));
+  }
+  ChainFrames out;
+  out.origin.assign(static_cast<std::size_t>(n) + 2, Eigen::Vector3d::Zero());
+  out.attitude.assign(static_cast<std::size_t>(n) + 2, Eigen::Vector4d(1, 0, 0, 0));
+  std::vector<Eigen::Vector3d> axis(static_cast<std::size_t>(n) + 1, Eigen::Vector3d::Zero());
+  for (int i = 1; i <= n + 1; ++i) {
+    const auto f = static_cast<std::size_t>(i);
+    const Eigen::Matrix3d previous = rotation_matrix(out.attitude[f - 1]);
+    if (i <= n) {
+      const auto j = static_cast<std::size_t>(i - 1);
+      const Eigen::Vector4d tilted = product(out.attitude[f - 1], about_x(chain.alpha[j]));
+      out.attitude[f] = product(tilted, about_z(q(i - 1)));
+      axis[f] = rotation_matrix(tilted).col(2);  // RotZ(q_i) leaves the z axis where it is
+      out.origin[f] = out.origin[f - 1] + chain.a[j] * previous.col(0) + chain.d[j] * axis[f];
+    } else {
+      out.attitude[f] = out.attitude[f - 1];
+      out.origin[f] = out.origin[f - 1] + chain.flange_d * previous.col(2);
+    }
+  }
+  if (!derivatives) return out;
+  out.d_origin.assign(static_cast<std::size_t>(n) + 2,
+                      Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, n));
+  out.d_attitude.assign(static_cast<std::size_t>(n) + 2,
+                        Eigen::Matrix<double, 4, Eigen::Dynamic>::Zero(4, n));
+  for (int f = 1; f <= n + 1; ++f) {
+    const auto frame = static_cast<std::size_t>(f);
+    for (int j = 1; j <= std::min(f, n); ++j) {
+      const Eigen::Vector3d& z = axis[static_cast<std::size_t>(j)];
+      out.d_origin[frame].col(j - 1) =
+          z.cross(out.origin[frame] - out.origin[static_cast<std::size_t>(j)]);
+      out.d_attitude[frame].col(j - 1) =
+          0.5 * product(Eigen::Vector4d(0.0, z.x(), z.y(), z.z()), out.attitude[frame]);
+    }
+  }
+  return out;
+}
+
+}  // namespace diffpills::trajopt
