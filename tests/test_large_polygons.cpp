@@ -408,6 +408,38 @@ TEST(LargePolygons, NearlyCoplanarOverlapIsAnIntersection) {
   }
 }
 
+// A triangle's vertex touching another triangle's face, the planes 7e-10 rad from parallel, the
+// other two vertices 1e-9 of the scene on either side of the face's plane (found by
+// fuzz_proximity): the section of such planes is too ill-conditioned to find the touch, and with
+// the vertex's height rounded just below the plane the search of the apart polygons had no
+// candidate over the face, answering a gap of 5e-10 of the scene in one order and a touch in the
+// other. Both orders against the brute force, in proximity and in the signed distance.
+TEST(LargePolygons, VertexTouchingANearlyParallelFaceTouchesInBothOrders) {
+  const TestShape core_a = regular_polygon(3, 2.6014606994458081e93),
+                  core_b = regular_polygon(3, 2.5194700025415293e93);
+  const double radii = 7.3333295109458388e91;  // b's; a has none
+  const auto& a = std::get<PaddedPolygon>(core_a.shape);
+  const PaddedPolygon b(std::get<PaddedPolygon>(core_b.shape).constraint_matrix(),
+                        std::get<PaddedPolygon>(core_b.shape).constraint_offsets(), radii);
+  const double w = 2.5194700025415145e93;
+  const Pose pa(Eigen::Vector3d(0, w, w), Eigen::Vector4d(w, 2.5194700050708732e93, w, w));
+  const Pose pb(Eigen::Vector3d(9.6223786342319118e-72, -6.9017463467905638e69,
+                                1.0352619520185846e70),
+                Eigen::Vector4d(-0.5, 0.5, -0.5, 0.5));
+  const double scene = 2.6e93;
+  ASSERT_LE(brute_force_closest(to_world(core_a, pa), to_world(core_b, pb)).distance,
+            1e-13 * scene);
+  const Proximity ab = proximity(a, pa, b, pb), ba = proximity(b, pb, a, pa);
+  EXPECT_TRUE(ab.cores_intersect);
+  EXPECT_TRUE(ba.cores_intersect);
+  EXPECT_LE((ab.core_points[1] - ab.core_points[0]).norm(), 1e-12 * scene);
+  EXPECT_LE((ba.core_points[1] - ba.core_points[0]).norm(), 1e-12 * scene);
+  EXPECT_LE((ab.core_points[0] - ba.core_points[1]).norm(), 1e-12 * scene);
+  const SignedDistance sab = signed_distance(a, pa, b, pb), sba = signed_distance(b, pb, a, pa);
+  EXPECT_NEAR(sab.distance, -radii, 1e-12 * scene);
+  EXPECT_NEAR(sba.distance, -radii, 1e-12 * scene);
+}
+
 // The penetration search of two polygons in one frame of scale 1 (the inputs are of order one):
 // pruned by the edge chains' hierarchies (as the public query above 32 x 32 vertices) or visiting
 // every edge pair.

@@ -81,12 +81,22 @@ struct Best {
   }
 };
 
-// The vertex of `polygon` (carried into the other's frame, where the other lies in z = 0) that
-// could be a closest point over the other's face: the lowest if the polygon lies wholly above the
-// plane, the highest if wholly below. Only a support point in the direction of the plane can be
-// closest over its interior (the closest pair's difference is then along the plane's normal and
-// separates the two). Its neighbouring edges, if parallel to the plane (|sin| <= 1e-12) and over
-// the face, are the interval version. `over` is the polygon lying in z = 0.
+// The vertices of `polygon` (carried into the other's frame, where the other lies in z = 0) that
+// could be a closest point over the other's face: the lowest if the polygon lies above the plane,
+// the highest if below. Only a support point in the direction of the plane can be closest over its
+// interior (the closest pair's difference is then along the plane's normal and separates the two).
+// Its neighbouring edges, if parallel to the plane (|sin| <= 1e-12) and over the face, are the
+// interval version. `over` is the polygon lying in z = 0.
+//
+// "Above" is within the intersection tolerance: a polygon whose lowest vertex is at most that far
+// below the plane counts as above it, the vertex as touching. Heights carry rounding of the
+// scene's size, and a polygon touching the face with one vertex, its plane 7e-10 rad from the
+// face's, has its other vertices within 1e-9 of the scene on both sides: rounding put the touching
+// vertex just below, the polygon "met the plane", and no candidate was left over the face (the
+// crossing-planes branch had missed the touch too: the section of nearly parallel planes is
+// ill-conditioned), so the answer was a gap of 5e-10 of the scene in one order of the shapes and
+// a touch in the other (found by fuzz_proximity). A polygon within the band on both sides offers
+// both its lowest and its highest vertex.
 template <class Polygon, class Over>
 void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, bool polygon_is_b,
                      double tolerance, Best& best) {
@@ -94,14 +104,6 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
   for (Eigen::Index j = 1; j < polygon.size(); ++j) {
     if (polygon[j].z() < polygon[lowest].z()) lowest = j;
     if (polygon[j].z() > polygon[highest].z()) highest = j;
-  }
-  Eigen::Index support = 0;
-  if (polygon[lowest].z() > 0.0) {
-    support = lowest;
-  } else if (polygon[highest].z() < 0.0) {
-    support = highest;
-  } else {
-    return;  // the polygon meets the plane: no point over the face can be closest
   }
   const auto candidate = [&](Kind b_kind, Kind a_kind, Eigen::Index feature, double parameter,
                              double height, double half_width, double half_shadow) {
@@ -116,28 +118,33 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
     (polygon_is_b ? c.j : c.i) = feature;
     return c;
   };
-  const Eigen::Vector3d& vertex = polygon[support];
-  if (contains(over, vertex.head<2>(), 0.0)) {
-    best.offer(
-        candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z(), 0.0, 0.0),
-        false);
-  }
-  const Eigen::Index following = support + 1 == polygon.size() ? 0 : support + 1;
-  for (const Eigen::Index j : {support, following}) {  // the two edges at the support vertex
-    const Eigen::Vector3d& start = polygon.start(j);
-    const Eigen::Vector3d& end = polygon.end(j);
-    if (std::abs(end.z() - start.z()) > 1e-12 * (end - start).norm()) continue;
-    const auto [low, high] = clip_line(over, start.head<2>(), (end - start).head<2>(), tolerance);
-    if (low <= high) {
-      const double middle = 0.5 * (low + high);
-      const double height = start.z() + middle * (end.z() - start.z());
-      // The interval: a part of the polygon's edge, and its shadow on the face.
-      const double half = 0.5 * (high - low);
-      best.offer(candidate(Kind::kBEdgeOverA, Kind::kAEdgeOverB, j, middle, height,
-                           half * (end - start).norm(), half * (end - start).head<2>().norm()),
-                 true);
+  const auto offer_support = [&](Eigen::Index support) {
+    const Eigen::Vector3d& vertex = polygon[support];
+    if (contains(over, vertex.head<2>(), 0.0)) {
+      best.offer(
+          candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z(), 0.0, 0.0),
+          false);
     }
-  }
+    const Eigen::Index following = support + 1 == polygon.size() ? 0 : support + 1;
+    for (const Eigen::Index j : {support, following}) {  // the two edges at the support vertex
+      const Eigen::Vector3d& start = polygon.start(j);
+      const Eigen::Vector3d& end = polygon.end(j);
+      if (std::abs(end.z() - start.z()) > 1e-12 * (end - start).norm()) continue;
+      const auto [low, high] = clip_line(over, start.head<2>(), (end - start).head<2>(), tolerance);
+      if (low <= high) {
+        const double middle = 0.5 * (low + high);
+        const double height = start.z() + middle * (end.z() - start.z());
+        // The interval: a part of the polygon's edge, and its shadow on the face.
+        const double half = 0.5 * (high - low);
+        best.offer(candidate(Kind::kBEdgeOverA, Kind::kAEdgeOverB, j, middle, height,
+                             half * (end - start).norm(), half * (end - start).head<2>().norm()),
+                   true);
+      }
+    }
+  };
+  const bool above = polygon[lowest].z() > -tolerance, below = polygon[highest].z() < tolerance;
+  if (above) offer_support(lowest);
+  if (below && !(above && highest == lowest)) offer_support(highest);
 }
 
 // The two sides of an over-face candidate: `other`'s vertex, or the point of its edge, over the
