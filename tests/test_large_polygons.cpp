@@ -423,9 +423,9 @@ TEST(LargePolygons, VertexTouchingANearlyParallelFaceTouchesInBothOrders) {
                         std::get<PaddedPolygon>(core_b.shape).constraint_offsets(), radii);
   const double w = 2.5194700025415145e93;
   const Pose pa(Eigen::Vector3d(0, w, w), Eigen::Vector4d(w, 2.5194700050708732e93, w, w));
-  const Pose pb(Eigen::Vector3d(9.6223786342319118e-72, -6.9017463467905638e69,
-                                1.0352619520185846e70),
-                Eigen::Vector4d(-0.5, 0.5, -0.5, 0.5));
+  const Pose pb(
+      Eigen::Vector3d(9.6223786342319118e-72, -6.9017463467905638e69, 1.0352619520185846e70),
+      Eigen::Vector4d(-0.5, 0.5, -0.5, 0.5));
   const double scene = 2.6e93;
   ASSERT_LE(brute_force_closest(to_world(core_a, pa), to_world(core_b, pb)).distance,
             1e-13 * scene);
