@@ -15,6 +15,9 @@
 //   Fcl_Broadphase/n         FCL: every object's transform set and its AABB computed, the
 //                            manager's update() (refit), and collide() with a callback that
 //                            counts the pairs of overlapping AABBs and asks for no narrowphase.
+//   *_Broadphase/FarBody/n   the same with body 0 moved alone to (1e9, 1e9, 1e9): the other
+//                            centres share one cell of the whole scene's grid (the hierarchy
+//                            must split them in their own bounds).
 //   Scene_Contacts/n         diffpills: Scene::contacts, broadphase and signed distance with the
 //                            gradients with respect to the body poses, margin 0.
 //   Fcl_BroadphaseDistance/n FCL: the same broadphase, then fcl::distance on every pair it reports
@@ -27,6 +30,7 @@
 #include <fcl/narrowphase/distance.h>
 
 #include <Eigen/Geometry>
+#include <map>
 #include <memory>
 #include <random>
 #include <vector>
@@ -64,9 +68,10 @@ struct BenchScene {
   std::vector<Pose> poses;
 };
 
-const BenchScene& bench_scene(int bodies) {
-  static std::vector<std::unique_ptr<BenchScene>> made(20000 + 1);
-  auto& slot = made[static_cast<std::size_t>(bodies)];
+// far_body: the same scene with body 0 moved to (1e9, 1e9, 1e9), alone.
+const BenchScene& bench_scene(int bodies, bool far_body = false) {
+  static std::map<std::pair<int, bool>, std::unique_ptr<BenchScene>> made;
+  auto& slot = made[{bodies, far_body}];
   if (slot) return *slot;
   std::mt19937_64 rng(static_cast<std::uint64_t>(bodies));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -90,6 +95,7 @@ const BenchScene& bench_scene(int bodies) {
     poses.emplace_back(Eigen::Vector3d(side * unit(rng), side * unit(rng), side * unit(rng)),
                        random_attitude(rng));
   }
+  if (far_body) poses[0] = Pose(Eigen::Vector3d::Constant(1e9), poses[0].q());
   slot = std::make_unique<BenchScene>(BenchScene{diffpills::Scene(list), poses});
   return *slot;
 }
@@ -159,8 +165,8 @@ void fcl_update(FclScene& f) {
   f.manager->update();
 }
 
-void Scene_Broadphase(benchmark::State& state) {
-  const BenchScene& s = bench_scene(static_cast<int>(state.range(0)));
+void Scene_Broadphase(benchmark::State& state, bool far_body) {
+  const BenchScene& s = bench_scene(static_cast<int>(state.range(0)), far_body);
   // Made once, as Scene's constructor does.
   const diffpills::detail::SceneOutlines outlines =
       diffpills::detail::make_outlines(s.scene.bodies());
@@ -173,8 +179,8 @@ void Scene_Broadphase(benchmark::State& state) {
   state.SetComplexityN(state.range(0));
 }
 
-void Fcl_Broadphase(benchmark::State& state) {
-  const BenchScene& s = bench_scene(static_cast<int>(state.range(0)));
+void Fcl_Broadphase(benchmark::State& state, bool far_body) {
+  const BenchScene& s = bench_scene(static_cast<int>(state.range(0)), far_body);
   const std::unique_ptr<FclScene> f = fcl_scene(s);
   Counter counter;
   for (auto _ : state) {
@@ -216,8 +222,11 @@ void Fcl_BroadphaseDistance(benchmark::State& state) {
 
 #define SCENE_SIZES \
   RangeMultiplier(10)->Range(100, 10000)->Complexity()->Unit(benchmark::kMillisecond)
-BENCHMARK(Scene_Broadphase)->SCENE_SIZES;
-BENCHMARK(Fcl_Broadphase)->SCENE_SIZES;
+#define FAR_BODY_SIZES Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)
+BENCHMARK_CAPTURE(Scene_Broadphase, , false)->SCENE_SIZES;
+BENCHMARK_CAPTURE(Fcl_Broadphase, , false)->SCENE_SIZES;
+BENCHMARK_CAPTURE(Scene_Broadphase, FarBody, true)->FAR_BODY_SIZES;
+BENCHMARK_CAPTURE(Fcl_Broadphase, FarBody, true)->FAR_BODY_SIZES;
 BENCHMARK(Scene_Contacts)->SCENE_SIZES;
 BENCHMARK(Fcl_BroadphaseDistance)->SCENE_SIZES;
 

@@ -78,6 +78,91 @@ TEST(BoxTree, OverlappingPairsAreEveryOverlappingPair) {
   }
 }
 
+// Pairs allowed by filters and a group predicate, against every pair tested directly: groups of
+// several boxes (a body's primitives), categories and masks, excluded group pairs.
+TEST(BoxTree, FilteredPairsAreEveryAllowedOverlappingPair) {
+  Rng rng(6);
+  for (int trial = 0; trial < 40; ++trial) {
+    const int count = std::uniform_int_distribution<int>(0, 300)(rng);
+    const int groups = std::max(1, count / std::uniform_int_distribution<int>(1, 6)(rng));
+    std::vector<detail::Box> boxes;
+    std::vector<detail::BoxFilter> filters;
+    for (int i = 0; i < count; ++i) {
+      const Eigen::Vector3d centre(uniform(rng, -4, 4), uniform(rng, -4, 4), uniform(rng, -4, 4));
+      const Eigen::Vector3d half(uniform(rng, 0, 0.8), uniform(rng, 0, 0.8), uniform(rng, 0, 0.8));
+      boxes.push_back({centre - half, centre + half});
+      const int group = std::uniform_int_distribution<int>(0, groups - 1)(rng);
+      // Categories 1, 2 or 4; some boxes not checked against category 2.
+      const std::uint32_t category = 1u << (group % 3);
+      const std::uint32_t mask = group % 4 == 1 ? ~2u : ~0u;
+      filters.push_back({group, category, mask});
+    }
+    const auto groups_checked = [](int g, int h) { return (g + h) % 5 != 0; };
+    std::vector<std::pair<int, int>> expected;
+    for (int i = 0; i < count; ++i) {
+      for (int j = i + 1; j < count; ++j) {
+        const detail::BoxFilter& f = filters[static_cast<std::size_t>(i)];
+        const detail::BoxFilter& g = filters[static_cast<std::size_t>(j)];
+        if (f.group == g.group || !(f.category & g.mask) || !(g.category & f.mask) ||
+            !groups_checked(f.group, g.group)) {
+          continue;
+        }
+        const detail::Box& a = boxes[static_cast<std::size_t>(i)];
+        const detail::Box& b = boxes[static_cast<std::size_t>(j)];
+        bool apart = false;
+        for (int k = 0; k < 3; ++k) apart = apart || a.high(k) < b.low(k) || b.high(k) < a.low(k);
+        if (!apart) expected.emplace_back(i, j);
+      }
+    }
+    std::vector<std::pair<int, int>> found =
+        detail::overlapping_pairs(boxes, filters, groups_checked);
+    std::sort(found.begin(), found.end());
+    ASSERT_EQ(found, expected) << "trial " << trial << ", " << count << " boxes";
+  }
+}
+
+// Clusters far smaller than the whole (a scene with one body 1e9 away, bodies at scales 2^-k)
+// are split as finely as the rest: the centres are keyed again in the cluster's own bounds. The
+// pairs are every overlapping pair, and boxes whose centres coincide still pair.
+TEST(BoxTree, ClustersFarSmallerThanTheWholeAreSplitCorrectly) {
+  Rng rng(7);
+  std::vector<detail::Box> boxes;
+  for (int i = 0; i < 600; ++i) {
+    const double scale = std::ldexp(1.0, -(i % 60));  // nested clusters down to 2^-59
+    const Eigen::Vector3d centre =
+        scale * Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Eigen::Vector3d half = scale * 0.05 * Eigen::Vector3d::Ones();
+    boxes.push_back({centre - half, centre + half});
+  }
+  boxes.push_back({Eigen::Vector3d::Constant(1e9), Eigen::Vector3d::Constant(1e9 + 1)});
+  for (int i = 0; i < 40; ++i) boxes.push_back({Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()});
+  std::vector<std::pair<int, int>> expected;
+  const int count = static_cast<int>(boxes.size());
+  for (int i = 0; i < count; ++i) {
+    for (int j = i + 1; j < count; ++j) {
+      if (detail::overlap(boxes[static_cast<std::size_t>(i)], boxes[static_cast<std::size_t>(j)])) {
+        expected.emplace_back(i, j);
+      }
+    }
+  }
+  std::vector<std::pair<int, int>> found = detail::overlapping_pairs(boxes);
+  std::sort(found.begin(), found.end());
+  EXPECT_EQ(found, expected);
+}
+
+// The primitives of one body never pair, however many overlap: a body of 2,000 coincident
+// capsules beside another body gives only the pairs across the bodies.
+TEST(BoxTree, OneGroupsBoxesNeverPair) {
+  const detail::Box unit{Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()};
+  std::vector<detail::Box> boxes(2000, unit);
+  std::vector<detail::BoxFilter> filters(2000);
+  EXPECT_TRUE(detail::overlapping_pairs(boxes, filters, [](int, int) { return true; }).empty());
+  boxes.push_back(unit);
+  filters.push_back({1, 1u, ~0u});
+  EXPECT_EQ(detail::overlapping_pairs(boxes, filters, [](int, int) { return true; }).size(), 2000u);
+  EXPECT_TRUE(detail::overlapping_pairs(boxes, filters, [](int, int) { return false; }).empty());
+}
+
 // A random scene: bodies of 0 to 3 primitives at random local poses, some excluded pairs and
 // filters.
 struct RandomScene {

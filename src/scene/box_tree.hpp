@@ -1,18 +1,29 @@
-// The broadphase of a scene query (scene.hpp): which of n axis-aligned boxes overlap.
+// The broadphase of a scene query (scene.hpp): which of n axis-aligned boxes overlap, among the
+// pairs a filter allows.
 //
 // A bounding-volume hierarchy is built over the boxes for each query (a linear BVH): the boxes'
 // centres get Morton codes in their bounding box (10 bits per axis, interleaved), are sorted by
 // them (radix sort, O(n)), and each range of codes is split where its first and last codes first
-// differ: the nodes are the cells of an octree over the centres, down to leaves of at most 4 boxes
-// (a range of equal codes is split in the middle). Bounds come from below, O(n). The tree is then
-// walked against itself: a node's pairs are its two children's own pairs plus the pairs across
-// them, and two nodes whose boxes do not overlap hold no pair across; at a fixed density of boxes
-// that visits about O(n log n) node pairs, plus the pairs found. A box far larger than the rest (a
-// table under many small parts) costs only the pairs it overlaps. Nothing is kept between
-// queries: the tree is a function of the boxes.
+// differ: the nodes are the cells of an octree over the centres, down to leaves of at most 2 boxes.
+// A range whose codes are all equal but whose centres are not (a cluster far smaller than the
+// whole, beside one far-away box) gets new codes in its own centres' bounding box and is sorted
+// again, so a cluster is split as finely as the rest; a range of identical centres is split in the
+// middle. Bounds come from below, O(n). The tree is then walked against itself: a node's pairs are
+// its two children's own pairs plus the pairs across them, and two nodes whose boxes do not
+// overlap hold no pair across; at a fixed density of boxes that visits about O(n log n) node
+// pairs, plus the pairs found. A box far larger than the rest (a table under many small parts)
+// costs only the pairs it overlaps. Nothing is kept between queries: the tree is a function of the
+// boxes.
+//
+// Filtering happens during the walk, not after it: each node knows the group of its boxes (if they
+// share one) and the union of their categories and of their masks, and a node pair that can hold
+// no allowed pair is not visited. So the many overlapping primitives of one body, or of bodies
+// whose categories never meet, cost neither time nor memory beyond the tree.
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -31,7 +42,22 @@ inline bool overlap(const Box& a, const Box& b) {
          b.low.y() <= a.high.y() && a.low.z() <= b.high.z() && b.low.z() <= a.high.z();
 }
 
-// Every pair (i, j), i < j, of overlapping boxes, in no particular order.
+// Which pairs a box may be in: never with a box of its own group (a body's primitives); only with
+// boxes whose category shares a bit with its mask and whose mask shares a bit with its category
+// (Box2D's filter); and only if the caller's groups_checked(group_a, group_b) allows the groups.
+struct BoxFilter {
+  int group = 0;
+  std::uint32_t category = 1;
+  std::uint32_t mask = 0xFFFFFFFFu;
+};
+
+// Every pair (i, j), i < j, of overlapping boxes that the filters allow, in no particular order.
+// filters has one entry per box; groups_checked is called with two different groups.
+std::vector<std::pair<int, int>> overlapping_pairs(
+    const std::vector<Box>& boxes, const std::vector<BoxFilter>& filters,
+    const std::function<bool(int, int)>& groups_checked);
+
+// Every pair of overlapping boxes (each box its own group, no filter).
 std::vector<std::pair<int, int>> overlapping_pairs(const std::vector<Box>& boxes);
 
 }  // namespace diffpills::detail

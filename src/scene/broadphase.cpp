@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "diffpills/rotation.hpp"
 
@@ -57,12 +58,19 @@ std::vector<std::pair<int, int>> broadphase(const Scene& scene, const SceneOutli
     box.low.array() -= slack;
     box.high.array() += slack;
   }
-  std::vector<std::pair<int, int>> pairs;
-  for (auto [u, v] : overlapping_pairs(boxes)) {
-    const int body_u = outlines.primitives[static_cast<std::size_t>(u)].body;
-    const int body_v = outlines.primitives[static_cast<std::size_t>(v)].body;
-    if (!scene.checked(body_u, body_v)) continue;
-    pairs.push_back(body_u < body_v ? std::pair{u, v} : std::pair{v, u});
+  std::vector<BoxFilter> filters(boxes.size());
+  for (std::size_t p = 0; p < boxes.size(); ++p) {
+    const int owner = outlines.primitives[p].body;
+    const CollisionFilter& filter = scene.body(owner).filter();
+    filters[p] = {owner, filter.category, filter.mask};
+  }
+  std::vector<std::pair<int, int>> pairs =
+      overlapping_pairs(boxes, filters, [&scene](int i, int j) { return scene.checked(i, j); });
+  for (auto& [u, v] : pairs) {
+    if (outlines.primitives[static_cast<std::size_t>(u)].body >
+        outlines.primitives[static_cast<std::size_t>(v)].body) {
+      std::swap(u, v);
+    }
   }
   return pairs;
 }

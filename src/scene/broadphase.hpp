@@ -11,9 +11,10 @@
 
 namespace diffpills::detail {
 
-// Pairs of indices into outlines.primitives whose boxes overlap, of two checked bodies, the earlier
-// body's primitive first, in no particular order. Throws std::invalid_argument as Scene::contacts
-// documents (pose count, margin, a primitive's world position beyond kMaxMagnitude).
+// Pairs of indices into outlines.primitives whose boxes overlap, of two checked bodies (filtered
+// during the walk, box_tree.hpp), the earlier body's primitive first, in no particular order.
+// Throws std::invalid_argument as Scene::contacts documents (pose count, margin, a primitive's
+// world position beyond kMaxMagnitude).
 std::vector<std::pair<int, int>> broadphase(const Scene& scene, const SceneOutlines& outlines,
                                             const std::vector<Pose>& body_poses, double margin);
 
