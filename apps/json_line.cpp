@@ -179,11 +179,10 @@ class LineBuilder {
 
 }  // namespace
 
-json parse_json_line(const std::string& line) {
+json parse_json_line(const std::string& line, const std::string& expected) {
   const std::size_t text_start = line.rfind(kByteOrderMark, 0) == 0 ? 3 : 0;
   if (line.find_first_not_of(" \t\r\n", text_start) == std::string::npos) {
-    throw std::invalid_argument(
-        "query: empty line; expected a JSON object with fields \"a\" and \"b\"");
+    throw std::invalid_argument("query: empty line; expected " + expected);
   }
   // nlohmann takes a NUL byte for the end of the text and would ignore what follows it.
   const std::size_t nul = line.find('\0');

@@ -17,10 +17,10 @@ constexpr std::size_t kMaxNesting = 64;
 // ordered_json) so that an object of n keys costs O(n log n) to build, not O(n^2). A UTF-8 byte
 // order mark at the start of the line is skipped; CR, like any JSON whitespace, is ignored.
 // Throws std::invalid_argument whose message starts with the field at fault ("a.r[1]: ...",
-// "query: ..." when no field is) for a blank line, a NUL byte, malformed JSON (the byte where the
-// parser stopped and why, mentioning NaN and Infinity only when the line holds such a word), a
-// number beyond the range of a double, a key given twice in one object, or nesting deeper than
-// kMaxNesting arrays and objects.
-nlohmann::json parse_json_line(const std::string& line);
+// "query: ..." when no field is) for a blank line ("query: empty line; expected <expected>"), a NUL
+// byte, malformed JSON (the byte where the parser stopped and why, mentioning NaN and Infinity only
+// when the line holds such a word), a number beyond the range of a double, a key given twice in one
+// object, or nesting deeper than kMaxNesting arrays and objects.
+nlohmann::json parse_json_line(const std::string& line, const std::string& expected);
 
 }  // namespace diffpills::app

@@ -59,14 +59,15 @@ std::string errno_reason() { return errno == 0 ? "" : std::string(": ") + std::s
 
 }  // namespace
 
-std::string answer_line(const std::string& line, const Answer& answer, bool& ok) {
+std::string answer_line(const std::string& line, const std::string& expected, const Answer& answer,
+                        bool& ok) {
   ok = false;
   try {
     if (line.size() > kMaxLineBytes) {
       throw std::invalid_argument("query: line longer than " + std::to_string(kMaxLineBytes) +
                                   " bytes");
     }
-    std::string result = to_line(answer(parse_json_line(line)));
+    std::string result = to_line(answer(parse_json_line(line, expected)));
     ok = true;
     return result;
   } catch (const std::bad_alloc&) {
@@ -78,7 +79,7 @@ std::string answer_line(const std::string& line, const Answer& answer, bool& ok)
 }
 
 int run_lines(std::istream& in, std::ostream& out, std::ostream& diagnostics,
-              const Answer& answer) {
+              const std::string& expected, const Answer& answer) {
   int status = kEveryLineAnswered;
   std::string line;
   for (;;) {
@@ -86,7 +87,7 @@ int run_lines(std::istream& in, std::ostream& out, std::ostream& diagnostics,
     errno = 0;
     if (!read_line(in, line)) break;
     bool ok = false;
-    const std::string answer_text = answer_line(line, answer, ok);
+    const std::string answer_text = answer_line(line, expected, answer, ok);
     errno = 0;
     out << answer_text << '\n';
     if (!flush_standard_output(out, diagnostics)) return kInputOutputFailed;

@@ -31,14 +31,17 @@ using Answer = std::function<nlohmann::ordered_json(const nlohmann::json&)>;
 
 // Answers one line: answer(the line parsed by parse_json_line) as one line of valid UTF-8 JSON, or
 // {"error": "..."} (bytes that are not UTF-8 are replaced by U+FFFD where an error quotes them, and
-// an error is cut at 1,000 bytes). Sets ok to false for an error answer. Never throws.
-std::string answer_line(const std::string& line, const Answer& answer, bool& ok);
+// an error is cut at 1,000 bytes). expected says what the command reads on a line ("a JSON object
+// with ..."), for the answer to a blank one. Sets ok to false for an error answer. Never throws.
+std::string answer_line(const std::string& line, const std::string& expected, const Answer& answer,
+                        bool& ok);
 
 // Answers every line of `in` on `out`, in order, flushing each answer. Returns
 // kEveryLineAnswered, or kSomeLineAnError if any line was answered with an error, or
 // kInputOutputFailed (after saying why on `diagnostics`) as soon as a write to `out` fails or if
 // reading `in` fails.
-int run_lines(std::istream& in, std::ostream& out, std::ostream& diagnostics, const Answer& answer);
+int run_lines(std::istream& in, std::ostream& out, std::ostream& diagnostics,
+              const std::string& expected, const Answer& answer);
 
 // Flushes `out`, standard output of the command. If this or an earlier write failed, says so on
 // `diagnostics` ("diffpills: cannot write to standard output: <errno's reason>"; set errno to 0

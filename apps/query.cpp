@@ -11,6 +11,8 @@ namespace {
 
 using json = nlohmann::json;
 
+const std::string kQueryLine = "a JSON object with fields \"a\" and \"b\"";
+
 // An optional true/false field, false when absent.
 bool flag(const json& query, const char* key) {
   if (!query.contains(key)) return false;
@@ -21,7 +23,7 @@ bool flag(const json& query, const char* key) {
 
 nlohmann::ordered_json answer(const json& query) {
   if (!query.is_object()) {
-    throw std::invalid_argument("query: must be a JSON object with fields \"a\" and \"b\"");
+    throw std::invalid_argument("query: must be " + kQueryLine);
   }
   static const std::set<std::string> allowed = {"a", "b", "jacobian", "method", "signed_distance"};
   for (const auto& item : query.items()) {
@@ -61,11 +63,11 @@ nlohmann::ordered_json answer(const json& query) {
 }  // namespace
 
 std::string answer_query_line(const std::string& line, bool& ok) {
-  return answer_line(line, answer, ok);
+  return answer_line(line, kQueryLine, answer, ok);
 }
 
 int run_query(std::istream& in, std::ostream& out, std::ostream& diagnostics) {
-  return run_lines(in, out, diagnostics, answer);
+  return run_lines(in, out, diagnostics, kQueryLine, answer);
 }
 
 }  // namespace diffpills::app

@@ -6,6 +6,7 @@
 #include <iterator>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -17,9 +18,12 @@ namespace {
 
 using json = nlohmann::json;
 
+const std::string kSceneLine = "a JSON object with a field \"poses\"";
+const std::string kSceneFile = "a JSON object with a field \"bodies\"";
+
 nlohmann::ordered_json answer(const Scene& scene, double default_margin, const json& query) {
   if (!query.is_object()) {
-    throw std::invalid_argument("query: must be a JSON object with a field \"poses\"");
+    throw std::invalid_argument("query: must be " + kSceneLine);
   }
   for (const auto& item : query.items()) {
     if (item.key() != "poses" && item.key() != "margin") {
@@ -53,8 +57,16 @@ nlohmann::ordered_json answer(const Scene& scene, double default_margin, const j
       throw std::invalid_argument("poses: body '" + scene.body(i).name() + "' has no pose");
     }
   }
+  std::vector<Contact> found;
+  try {
+    found = scene.contacts(poses, margin);
+  } catch (const BodyPoseError& error) {
+    // Named as the line names it: the body's pose is poses.<name>.
+    throw std::invalid_argument("poses." + scene.body(error.body()).name() + ", shape " +
+                                std::to_string(error.shape()) + ": " + error.reason());
+  }
   nlohmann::ordered_json contacts = nlohmann::ordered_json::array();
-  for (const Contact& contact : scene.contacts(poses, margin)) {
+  for (const Contact& contact : found) {
     contacts.push_back(to_json(contact, scene));
   }
   return {{"contacts", std::move(contacts)}};
@@ -76,24 +88,27 @@ Scene load_scene(const std::string& path) {
   if (file.bad()) throw std::invalid_argument("cannot read the scene file");
   json value;
   try {
-    value = parse_json_line(text);
+    value = parse_json_line(text, kSceneFile);
   } catch (const std::bad_alloc&) {
     throw std::invalid_argument("not enough memory to parse the scene file");
   } catch (const std::invalid_argument& error) {
-    // The line parser names the whole text "query"; here it is the file.
-    const std::string message = error.what();
-    throw std::invalid_argument(message.rfind("query: ", 0) == 0 ? message.substr(7) : message);
+    // The line parser names the whole text "query" and calls it a line; here it is the file.
+    std::string message = error.what();
+    if (message.rfind("query: ", 0) == 0) message.erase(0, 7);
+    if (message.rfind("empty line", 0) == 0) message.replace(0, 10, "empty file");
+    throw std::invalid_argument(message);
   }
   return parse_scene(value);
 }
 
-// A margin argument: a finite number of magnitude at most 1e100, the whole argument.
+// A margin argument: the whole argument a number as JSON writes one (the margin of a line is
+// one), of magnitude at most 1e100. strtod alone would also take hex, "inf", leading spaces and
+// a leading '+'.
 bool parse_margin(const std::string& text, double& margin) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  margin = std::strtod(text.c_str(), &end);
-  return end == text.c_str() + text.size() && std::isfinite(margin) &&
-         std::abs(margin) <= kMaxMagnitude;
+  static const std::regex json_number(R"(-?(0|[1-9][0-9]*)(\.[0-9]+)?([eE][+-]?[0-9]+)?)");
+  if (!std::regex_match(text, json_number)) return false;
+  margin = std::strtod(text.c_str(), nullptr);
+  return std::isfinite(margin) && std::abs(margin) <= kMaxMagnitude;
 }
 
 }  // namespace
@@ -101,15 +116,22 @@ bool parse_margin(const std::string& text, double& margin) {
 std::string answer_scene_line(const Scene& scene, double default_margin, const std::string& line,
                               bool& ok) {
   return answer_line(
-      line, [&](const json& query) { return answer(scene, default_margin, query); }, ok);
+      line, kSceneLine, [&](const json& query) { return answer(scene, default_margin, query); },
+      ok);
 }
 
 int run_scene_command(const std::vector<std::string>& arguments, std::istream& in,
                       std::ostream& out, std::ostream& diagnostics) {
   std::string path;
   double margin = 0.0;
+  bool margin_given = false;
   for (std::size_t i = 0; i < arguments.size(); ++i) {
+    if (arguments[i] == "--margin" && margin_given) {
+      diagnostics << "diffpills scene: --margin given twice\n";
+      return kMisuse;
+    }
     if (arguments[i] == "--margin") {
+      margin_given = true;
       if (i + 1 == arguments.size() || !parse_margin(arguments[i + 1], margin)) {
         diagnostics << "diffpills scene: --margin needs a finite number of magnitude at most "
                        "1e100\n";
@@ -136,7 +158,7 @@ int run_scene_command(const std::vector<std::string>& arguments, std::istream& i
     diagnostics << "diffpills scene: " << path << ": " << error.what() << "\n";
     return kMisuse;
   }
-  return run_lines(in, out, diagnostics,
+  return run_lines(in, out, diagnostics, kSceneLine,
                    [&](const json& query) { return answer(scene, margin, query); });
 }
 

@@ -87,7 +87,8 @@ const diffpills::Scene& fixed_scene() {
 void check_scene_file(const std::string& input) {
   diffpills::Scene scene;
   try {
-    scene = diffpills::app::parse_scene(diffpills::app::parse_json_line(input));
+    scene = diffpills::app::parse_scene(
+        diffpills::app::parse_json_line(input, "a JSON object with a field \"bodies\""));
   } catch (const std::invalid_argument&) {
     return;  // documented: a bad file is an error naming the field
   }

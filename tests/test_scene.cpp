@@ -404,6 +404,30 @@ TEST(Scene, EmptyScenesAndEmptyBodies) {
   EXPECT_EQ(with_empty.index_of("nobody"), -1);
 }
 
+// A scene moved from is the empty scene, usable (it once kept no outlines and crashed), and the
+// scene moved to answers as the original.
+TEST(Scene, AMovedFromSceneIsTheEmptyScene) {
+  const std::vector<Body> bodies = {Body("a", {{Capsule(1, 0.1), Pose()}}),
+                                    Body("b", {{Capsule(1, 0.1), Pose()}})};
+  const std::vector<Pose> poses = {Pose(),
+                                   Pose(Eigen::Vector3d(0, 0.15, 0), Eigen::Vector4d(1, 0, 0, 0))};
+  Scene source(bodies);
+  const Scene moved(std::move(source));
+  EXPECT_EQ(source.size(), 0);  // NOLINT(bugprone-use-after-move): the state is the subject
+  EXPECT_TRUE(source.contacts({}, 1.0).empty());
+  EXPECT_EQ(source.index_of("a"), -1);
+  ASSERT_EQ(moved.contacts(poses, 0.0).size(), 1u);
+  Scene assigned(bodies);
+  Scene target;
+  target = std::move(assigned);
+  EXPECT_EQ(assigned.size(), 0);  // NOLINT(bugprone-use-after-move)
+  EXPECT_TRUE(assigned.contacts({}, 1.0).empty());
+  EXPECT_NEAR(target.contacts(poses, 0.0).at(0).distance, -0.05, 1e-15);
+  const Scene copy = target;  // copies share the outlines and both answer
+  EXPECT_EQ(copy.contacts(poses, 0.0).size(), 1u);
+  EXPECT_EQ(target.contacts(poses, 0.0).size(), 1u);
+}
+
 TEST(Scene, ErrorsNameTheField) {
   const auto message = [](const auto& make) {
     try {

@@ -146,6 +146,24 @@ TEST(SceneCli, BadLinesGetAnErrorAndTheNextLinesAreAnswered) {
                         "\n")
                 .out.find("margin: must be a number"),
             std::string::npos);
+  // A blank line is answered as this command's line, not a query's.
+  const json blank = json::parse(run({path}, " \n").out);
+  EXPECT_EQ(blank["error"], "query: empty line; expected a JSON object with a field \"poses\"");
+}
+
+// A pose that puts a primitive beyond 1e100 is named as the line names it: poses.<body>.
+TEST(SceneCli, APrimitiveBeyondTheLimitIsNamedByTheLinesField) {
+  const std::string path = write_file("far_scene.json", R"({"bodies": [
+    {"name": "near", "shapes": []},
+    {"name": "far", "shapes": [{"type": "capsule", "length": 1, "radius": 0.1,
+                                "r": [1e100, 0, 0], "q": [1, 0, 0, 0]}]}]})");
+  const CommandRun result =
+      run({path}, one_line(R"({"poses": {"near": {"r": [0, 0, 0], "q": [1, 0, 0, 0]},
+                                         "far": {"r": [1e100, 0, 0], "q": [1, 0, 0, 0]}}})") +
+                      "\n");
+  EXPECT_EQ(result.status, 1);
+  EXPECT_EQ(json::parse(result.out)["error"],
+            "poses.far, shape 0: its world position is beyond 1e100 in magnitude");
 }
 
 TEST(SceneCli, BadSceneFilesAndArgumentsEndWithStatus2) {
@@ -167,9 +185,20 @@ TEST(SceneCli, BadSceneFilesAndArgumentsEndWithStatus2) {
   EXPECT_TRUE(mentions(failure({path, "--margin"}), "--margin needs"));
   EXPECT_TRUE(mentions(failure({path, "--margin", "inf"}), "--margin needs"));
   EXPECT_TRUE(mentions(failure({path, "--margin", "0.1x"}), "--margin needs"));
+  // JSON's number grammar, the whole argument: no hex, no spaces, no leading '+' or '.'.
+  for (const char* margin :
+       {"0x1p-3", " 0.1", "0.1 ", "+0.1", ".5", "1.", "01", "", "nan", "1e101"}) {
+    EXPECT_TRUE(mentions(failure({path, "--margin", margin}), "--margin needs")) << margin;
+  }
+  EXPECT_TRUE(
+      mentions(failure({path, "--margin", "0.1", "--margin", "0.2"}), "--margin given twice"));
+  EXPECT_EQ(run({path, "--margin", "-0.5e-1"}, "").status, 0);
+  EXPECT_EQ(run({path, "--margin", "1E+2"}, "").status, 0);
   EXPECT_TRUE(mentions(failure({path, "other.json"}), "unexpected argument 'other.json'"));
   EXPECT_TRUE(mentions(failure({path, "--verbose"}), "unexpected argument '--verbose'"));
   EXPECT_TRUE(mentions(file_failure("{"), "malformed JSON"));
+  EXPECT_TRUE(mentions(file_failure(" \n"),
+                       ": empty file; expected a JSON object with a field \"bodies\""));
   EXPECT_TRUE(mentions(file_failure("[]"), "scene: must be an object"));
   EXPECT_TRUE(mentions(file_failure(R"({"exclude": []})"), "scene.bodies: missing"));
   EXPECT_TRUE(mentions(file_failure(R"({"bodies": {}})"), "bodies: must be an array"));

@@ -10,9 +10,9 @@
 // upper arm, the elbow, the forearm and the wrist, each about as wide as the link; the hand is a
 // padded rectangle 0.2 m wide in the flange's y-z plane. Frames next to each other in the chain
 // are never checked against each other (their shapes overlap at the joints), nor frames 2 and 4 or
-// 3 and 5, whose capsules overlap at the elbow in most configurations (random joint angles:
-// always and 58% of the time), nor 5 and 7, whose crude capsules overlap when the wrist is bent
-// back (q6 > ~3.3, 21% of random angles) where the real links clear each other by the wrist's
+// 3 and 5, whose capsules overlap at the elbow in every configuration (both pairs at all of
+// 20,000 random joint angles within the limits), nor 5 and 7, whose crude capsules overlap when the
+// wrist is bent back (q6 > ~3.3, 20% of those angles) where the real links clear each other by the wrist's
 // 0.088 m offset; every other pair is a self-collision the solver avoids.
 //
 // The shelf: six padded-polygon boards (padding 0.01 m): bottom and top boards at heights 0.55 and

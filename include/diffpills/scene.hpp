@@ -45,6 +45,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -56,6 +57,22 @@ namespace diffpills {
 namespace detail {
 struct SceneOutlines;  // the primitives as the broadphase reads them (src/scene/scene_outlines.hpp)
 }  // namespace detail
+
+// What Scene::contacts throws when a body's pose puts one of its primitives' origins beyond
+// kMaxMagnitude: what() reads "body_poses[3] (body 'arm'), shape 1: <reason>"; body(), shape() and
+// reason() let a caller that names the poses otherwise (a command's "poses.arm", Python's r[3] and
+// q[3]) say it in its own terms.
+class BodyPoseError : public std::invalid_argument {
+ public:
+  BodyPoseError(int body, const std::string& body_name, int shape, std::string reason);
+  int body() const { return body_; }
+  int shape() const { return shape_; }
+  const std::string& reason() const { return reason_; }
+
+ private:
+  int body_, shape_;
+  std::string reason_;
+};
 
 // A primitive of a body and its pose in the body's frame.
 struct BodyShape {
@@ -108,6 +125,13 @@ class Scene {
   // ("exclude[0]: ...").
   explicit Scene(std::vector<Body> bodies,
                  const std::vector<std::pair<std::string, std::string>>& exclude = {});
+  // Copies share the immutable broadphase outlines. A scene moved from is the empty scene (not a
+  // scene left without them).
+  Scene(const Scene&) = default;
+  Scene& operator=(const Scene&) = default;
+  Scene(Scene&& other) noexcept;
+  Scene& operator=(Scene&& other) noexcept;
+  ~Scene() = default;
 
   int size() const { return static_cast<int>(bodies_.size()); }
   const std::vector<Body>& bodies() const { return bodies_; }
@@ -122,15 +146,17 @@ class Scene {
   // Every primitive pair of two checked bodies whose signed distance is <= margin, sorted (see
   // above). body_poses holds one pose per body, in the scene's order. Throws
   // std::invalid_argument for a count that is not the scene's ("body_poses: ..."), a margin that
-  // is not finite or beyond kMaxMagnitude ("margin: ..."), or a primitive whose world pose is
-  // beyond kMaxMagnitude ("body_poses[3] (body 'arm'), shape 1: ...").
+  // is not finite or beyond kMaxMagnitude ("margin: ..."), and throws BodyPoseError (an
+  // std::invalid_argument) for a primitive whose world position is beyond kMaxMagnitude
+  // ("body_poses[3] (body 'arm'), shape 1: ...").
   std::vector<Contact> contacts(const std::vector<Pose>& body_poses, double margin = 0.0) const;
 
  private:
   std::vector<Body> bodies_;
   std::vector<std::pair<int, int>> excluded_;
-  std::vector<std::pair<std::string, int>> names_;         // sorted by name, for index_of
-  std::shared_ptr<const detail::SceneOutlines> outlines_;  // immutable, shared by copies
+  std::vector<std::pair<std::string, int>> names_;  // sorted by name, for index_of
+  std::shared_ptr<const detail::SceneOutlines>
+      outlines_;  // immutable, shared by copies, never null
 };
 
 }  // namespace diffpills

@@ -12,7 +12,9 @@ the bodies of a scene.
 The forward pass is ``diffpills.proximity_batch`` on the CPU in float64; the backward pass
 multiplies the incoming gradient by the library's exact gradient of phi (no finite differences, no
 second derivatives: the function is once differentiable). Inputs may be float64 or float32, on any
-device; phi comes back in the inputs' dtype and on their device.
+device; phi comes back in the inputs' dtype and on their device. A result beyond float32's range
+(3.4e38, phi of poses 1e19 apart) raises ValueError naming it instead of turning into inf: use
+float64 inputs for such scenes.
 """
 
 import numpy as np
@@ -39,6 +41,20 @@ def _as_numpy(tensor):
     return np.ascontiguousarray(tensor.detach().to(device="cpu", dtype=torch.float64).numpy())
 
 
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+def _tensor(name, array, like):
+    """The float64 result ``array`` as a tensor of ``like``'s dtype and device; ValueError if a
+    finite value of it would overflow float32 (to inf, silently, in torch's conversion)."""
+    if like["dtype"] == torch.float32 and array.size and np.max(np.abs(array)) > _FLOAT32_MAX:
+        raise ValueError(
+            f"{name}: {np.max(np.abs(array)):.3g} in magnitude is beyond float32's range "
+            f"({_FLOAT32_MAX:.3g}); pass float64 tensors"
+        )
+    return torch.from_numpy(array).to(**like)
+
+
 class _Batch(torch.autograd.Function):
     """A value of N pose pairs (phi or the signed distance), with backward through the analytic
     gradient. ``batch`` is the diffpills batch function, called with keyword ``options``."""
@@ -48,8 +64,9 @@ class _Batch(torch.autograd.Function):
         value, gradient = batch(
             a, _as_numpy(r_a), _as_numpy(q_a), b, _as_numpy(r_b), _as_numpy(q_b), **options
         )
-        ctx.save_for_backward(torch.from_numpy(gradient).to(device=r_a.device, dtype=r_a.dtype))
-        return torch.from_numpy(value).to(device=r_a.device, dtype=r_a.dtype)
+        like = {"device": r_a.device, "dtype": r_a.dtype}
+        ctx.save_for_backward(_tensor("gradient", gradient, like))
+        return _tensor("phi" if batch is _core.proximity_batch else "distance", value, like)
 
     @staticmethod
     def backward(ctx, grad_phi):
@@ -143,20 +160,21 @@ class _SceneContacts(torch.autograd.Function):
         bodies = torch.from_numpy(found.bodies.astype(np.int64)).to(device=r.device)
         ctx.save_for_backward(
             bodies,
-            torch.from_numpy(found.gradient).to(**like),
-            torch.from_numpy(found.phi_gradient).to(**like),
+            _tensor("gradient", found.gradient, like),
+            _tensor("phi_gradient", found.phi_gradient, like),
         )
         ctx.bodies = r.shape[0]
         others = (
             bodies,
             torch.from_numpy(found.shapes.astype(np.int64)).to(device=r.device),
-            torch.from_numpy(found.points).to(**like),
+            _tensor("points", found.points, like),
             torch.from_numpy(found.normal).to(**like),
-            torch.from_numpy(found.gradient).to(**like),
-            torch.from_numpy(found.phi_gradient).to(**like),
+            _tensor("gradient", found.gradient, like),
+            _tensor("phi_gradient", found.phi_gradient, like),
         )
         ctx.mark_non_differentiable(*others)
-        return (torch.from_numpy(found.distance).to(**like), torch.from_numpy(found.phi).to(**like)) + others
+        distance = _tensor("distance", found.distance, like)
+        return (distance, _tensor("phi", found.phi, like)) + others
 
     @staticmethod
     def backward(ctx, grad_distance, grad_phi, *unused):

@@ -896,9 +896,15 @@ py::object scene_contacts(const Scene& scene, const py::handle& r, const py::han
     }
   }
   std::vector<Contact> found;
-  {
+  try {
     py::gil_scoped_release release;
     found = scene.contacts(poses, margin);
+  } catch (const diffpills::BodyPoseError& error) {
+    // Named as the caller names the pose: rows of r and q.
+    const std::string row = "[" + std::to_string(error.body()) + "]";
+    throw py::value_error("r" + row + " and q" + row + " (body '" +
+                          scene.body(error.body()).name() + "'), shape " +
+                          std::to_string(error.shape()) + ": " + error.reason());
   }
   const auto k = static_cast<py::ssize_t>(found.size());
   py::array_t<int> bodies({k, py::ssize_t{2}}), shapes({k, py::ssize_t{2}});
@@ -959,8 +965,9 @@ category shares a bit with the other's mask.)")
       .def_property_readonly("mask", [](const Body& b) { return b.filter().mask; })
       .def("__repr__",
            [](const Body& b) {
-             return "diffpills.Body('" + b.name() + "', " + std::to_string(b.shapes().size()) +
-                    " shapes)";
+             // The name as Python writes a str, quotes and control characters escaped.
+             return "diffpills.Body(" + std::string(py::repr(py::str(b.name()))) + ", " +
+                    std::to_string(b.shapes().size()) + " shapes)";
            })
       .def(py::pickle(
           [](const Body& b) -> py::object {

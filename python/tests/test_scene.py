@@ -157,6 +157,13 @@ def test_exclusions_filters_and_empty_scenes():
     assert scene.names == ["a", "b", "c", "d"]
 
 
+def test_body_repr_escapes_the_name():
+    name = "it's\n\"odd\""
+    text = repr(diffpills.Body(name, []))
+    assert text == "diffpills.Body(" + repr(name) + ", 0 shapes)"
+    assert "\n" not in text
+
+
 def test_pickling_keeps_the_scene():
     rng = np.random.default_rng(14)
     scene, r, q = random_scene(rng, 8, 0.6)
@@ -171,6 +178,7 @@ def test_pickling_keeps_the_scene():
 def test_errors_name_the_field():
     stick = diffpills.Capsule(1.0, 0.1)
     good = diffpills.Body("a", [(stick, diffpills.Pose())])
+    far_scene = diffpills.Scene([diffpills.Body("far", [(stick, diffpills.Pose([1e100, 0, 0], [1, 0, 0, 0]))])])
     cases = [
         (lambda: diffpills.Body("", []), ValueError, "body.name: must not be empty"),
         (lambda: diffpills.Body(3, []), TypeError, "name: expected a str"),
@@ -191,6 +199,8 @@ def test_errors_name_the_field():
         (lambda: diffpills.Scene([good]).contacts([[0, 0, 0]], [[1, 0, 0, 0]], margin=np.inf), ValueError, "margin: must be finite"),
         (lambda: diffpills.Scene([good]).contacts([[0, 0, 0]], [[1, 0, 0, 0]], margin="x"), TypeError, "margin"),
         (lambda: diffpills.Scene.__new__(diffpills.Scene).contacts([], []), TypeError, "made by __new__"),
+        (lambda: far_scene.contacts([[1e100, 0, 0]], [[1, 0, 0, 0]]), ValueError,
+         r"^r\[0\] and q\[0\] \(body 'far'\), shape 0: its world position is beyond 1e100"),
     ]
     for make, error, message in cases:
         with pytest.raises(error, match=message):

@@ -112,6 +112,26 @@ def test_bad_input():
         dtorch.proximity(capsule, np.zeros((4, 3)), q, capsule, r, q)
 
 
+def test_float32_results_beyond_its_range_raise_instead_of_inf():
+    capsule = diffpills.Capsule(1.0, 0.1)
+    q = torch.tensor([1.0, 0.0, 0.0, 0.0])
+    near, far = torch.zeros(3), torch.tensor([1e20, 0.0, 0.0])
+    # phi = 1e40 > 3.4e38: float32 cannot hold it.
+    with pytest.raises(ValueError, match=r"^phi: 1e\+40 in magnitude is beyond float32's range"):
+        dtorch.proximity(capsule, near, q, capsule, far, q)
+    # The distance itself (1e20) fits; in float64 phi does too.
+    distance = dtorch.signed_distance(capsule, near, q, capsule, far, q)
+    assert distance.dtype == torch.float32 and torch.isfinite(distance).all()
+    phi = dtorch.proximity(capsule, near.double(), q.double(), capsule, far.double(), q.double())
+    assert phi.item() == pytest.approx(1e40, rel=1e-6)  # 1e20 in float32 is 1.00000002e20
+    scene = diffpills.Scene([diffpills.Body("a", [(capsule, diffpills.Pose())]),
+                             diffpills.Body("b", [(capsule, diffpills.Pose())])])
+    r = torch.stack([near, far])
+    with pytest.raises(ValueError, match="^phi: .* beyond float32's range"):
+        dtorch.scene_contacts(scene, r, torch.stack([q, q]), margin=1e21)
+    assert dtorch.scene_contacts(scene, r.double(), torch.stack([q, q]).double(), margin=1e21).phi.item() > 1e39
+
+
 def test_a_pose_refuses_a_tensor_that_requires_grad():
     # A Pose holds plain numbers outside autograd: reading a tensor that requires grad would silently
     # cut it from its graph, so the error says to detach it (or to use diffpills.torch.proximity).

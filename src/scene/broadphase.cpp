@@ -36,10 +36,8 @@ std::vector<std::pair<int, int>> broadphase(const Scene& scene, const SceneOutli
     const Eigen::Vector3d origin =
         r + R * scene.body(body).shapes()[static_cast<std::size_t>(primitive.shape)].pose.r();
     if (!(origin.cwiseAbs().maxCoeff() <= kMaxMagnitude)) {
-      throw std::invalid_argument("body_poses[" + std::to_string(body) + "] (body '" +
-                                  scene.body(body).name() + "'), shape " +
-                                  std::to_string(primitive.shape) +
-                                  ": its world position is beyond 1e100 in magnitude");
+      throw BodyPoseError(body, scene.body(body).name(), primitive.shape,
+                          "its world position is beyond 1e100 in magnitude");
     }
     // ... and its points.
     Box& box = boxes[p];

@@ -6,8 +6,10 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
 #include <variant>
 
 #include "broadphase.hpp"
@@ -48,12 +50,53 @@ double radius_of(const Shape& shape) {
 
 }  // namespace
 
+BodyPoseError::BodyPoseError(int body, const std::string& body_name, int shape, std::string reason)
+    : std::invalid_argument("body_poses[" + std::to_string(body) + "] (body '" + body_name +
+                            "'), shape " + std::to_string(shape) + ": " + reason),
+      body_(body),
+      shape_(shape),
+      reason_(std::move(reason)) {}
+
 Body::Body(std::string name, std::vector<BodyShape> shapes, CollisionFilter filter)
     : name_(std::move(name)), shapes_(std::move(shapes)), filter_(filter) {
   if (name_.empty()) throw std::invalid_argument("body.name: must not be empty");
 }
 
-Scene::Scene() : outlines_(std::make_shared<detail::SceneOutlines>()) {}
+namespace {
+
+// The outlines of the empty scene, one for every empty scene: a moved-from scene takes them
+// without allocating, so the moves cannot throw.
+const std::shared_ptr<const detail::SceneOutlines>& empty_outlines() {
+  static const std::shared_ptr<const detail::SceneOutlines> empty =
+      std::make_shared<detail::SceneOutlines>();
+  return empty;
+}
+
+}  // namespace
+
+Scene::Scene() : outlines_(empty_outlines()) {}
+
+Scene::Scene(Scene&& other) noexcept
+    : bodies_(std::move(other.bodies_)),
+      excluded_(std::move(other.excluded_)),
+      names_(std::move(other.names_)),
+      outlines_(std::exchange(other.outlines_, empty_outlines())) {
+  other.bodies_.clear();
+  other.excluded_.clear();
+  other.names_.clear();
+}
+
+Scene& Scene::operator=(Scene&& other) noexcept {
+  if (this == &other) return *this;
+  bodies_ = std::move(other.bodies_);
+  excluded_ = std::move(other.excluded_);
+  names_ = std::move(other.names_);
+  outlines_ = std::exchange(other.outlines_, empty_outlines());
+  other.bodies_.clear();
+  other.excluded_.clear();
+  other.names_.clear();
+  return *this;
+}
 
 Scene::Scene(std::vector<Body> bodies,
              const std::vector<std::pair<std::string, std::string>>& exclude)
