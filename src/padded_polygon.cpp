@@ -21,9 +21,15 @@
 // rows of a 10^5-gon (whose neighbours cut ~2e-9 of its size). If angle(a, c) >= pi (k <= 0), b is
 // needed to close the polygon and always kept.
 //
-// Bounded <=> consecutive kept normals turn by less than pi. A turn within 1e-12 of pi (or of 0)
-// puts a vertex near infinity; vertices more than 1e12 times the largest offset from the origin
-// are reported as unbounded too, since their position is then fixed only to ~1e-4.
+// Bounded <=> consecutive kept normals turn by less than pi. The vertex of a turn within 1e-12 of
+// 0 is not fixed by the rows, and is reported as unbounded. The vertex v of a turn within 1e-12
+// of pi, k = sin(turn) <= 1e-12, is fixed only if the rounding of k (a few 1e-16 absolute in
+// n_a x n_c, so |v| 4.4e-16 / k in v) stays below 1e-12 of the polygon's size: a spike of rows
+// whose offsets are far below the largest (x <= 1e-300 and -x + 1e-16 y <= 1e-300 meet at y =
+// 2e-284 in a polygon of size 1; the row y <= 1e-300 between them is dropped as cutting nothing
+// of that size) is a vertex, the same turn between offsets of the polygon's size is not. Vertices
+// more than 1e12 times the largest offset from the origin are reported as unbounded too, since
+// their position is then fixed only to ~1e-4.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -44,6 +50,11 @@ struct UnitRow {
 
 // The smallest normalized offset d_i / |C_i| accepted.
 constexpr double kMinOffset = 1e-300;
+
+// Turns (sines, n_a x n_c) at or below this are checked for the vertex they fix (see above), and
+// the rounding of a sine of unit normals: 2 products of rounded unit vectors, 2^-52 each.
+constexpr double kSmallestTurn = 1e-12;
+constexpr double kTurnRounding = 4.4e-16;
 
 double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
@@ -153,12 +164,17 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
     const UnitRow& a = kept[static_cast<std::size_t>(i)];
     const UnitRow& c = kept[static_cast<std::size_t>((i + 1) % k)];
     const double turn = cross(a.normal, c.normal);
-    if (!(turn > 1e-12)) unbounded();
+    const bool near_pi = a.normal.dot(c.normal) < 0.0;
+    if (!(turn > (near_pi ? 0.0 : kSmallestTurn))) unbounded();
     const Eigen::Vector2d vertex = (a.offset * Eigen::Vector2d(c.normal.y(), -c.normal.x()) +
                                     c.offset * Eigen::Vector2d(-a.normal.y(), a.normal.x())) /
                                    turn;
+    const double distance = std::hypot(vertex.x(), vertex.y());  // no underflow of squares
+    if (turn <= kSmallestTurn && !(distance * (kTurnRounding / turn) <= 1e-12 * largest_offset)) {
+      unbounded();
+    }
     vertices_.row(i) = vertex.transpose();
-    extent_ = std::max(extent_, std::hypot(vertex.x(), vertex.y()));  // no underflow of squares
+    extent_ = std::max(extent_, distance);
   }
   if (!(extent_ <= 1e12 * largest_offset)) unbounded();
   if (!(extent_ <= kMaxMagnitude)) {

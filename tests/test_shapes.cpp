@@ -133,6 +133,39 @@ TEST(Shapes, PolygonRejectsOffsetsThatUnderflow) {
   EXPECT_GT(tiny.extent(), 0.0);
 }
 
+// A sliver far thinner than it is long, its rows at 0, 90, 180 and 270 degrees as cos and sin
+// give them (6e-17 off): x <= e, y <= e, -x <= e, -y <= 1 with e = 1e-300 down to 1e-20. The row
+// y <= e is dropped (it cuts 1e-284 of a polygon of size 1), leaving the rows x <= e and
+// -x + 1.2e-16 y <= e nearly opposite, meeting at a spike within 1e-12 of the size of the apex: a
+// polygon, once reported unbounded. Every vertex satisfies every row within 1e-12 of the size,
+// and the extent is the farthest corner's, computed here from the rows by hand.
+TEST(Shapes, AnOrthogonalSliverWithRoundedRowsIsAPolygon) {
+  Eigen::MatrixX2d C(4, 2);
+  for (int i = 0; i < 4; ++i) C.row(i) << std::cos(i * M_PI / 2), std::sin(i * M_PI / 2);
+  for (const double e : {1e-300, 1e-200, 1e-100, 1e-20}) {
+    const Eigen::Vector4d d(e, e, e, 1.0);
+    const PaddedPolygon sliver(C, d, 0.1);
+    // The far corners (x = e or the third row's line, y on the fourth row's line) are 1 away.
+    EXPECT_NEAR(sliver.extent(), 1.0, 1e-12) << e;
+    for (Eigen::Index v = 0; v < sliver.vertices().rows(); ++v) {
+      const Eigen::Vector4d slack = d - C * sliver.vertices().row(v).transpose();
+      EXPECT_GE(slack.minCoeff(), -1e-12) << "e " << e << " vertex " << v;
+    }
+    // Both corners at y = -1 are vertices, and the apex lies within 1e-12 of the origin.
+    double lowest = 0.0, highest = -1.0;
+    for (Eigen::Index v = 0; v < sliver.vertices().rows(); ++v) {
+      lowest = std::min(lowest, sliver.vertices()(v, 1));
+      highest = std::max(highest, sliver.vertices()(v, 1));
+    }
+    EXPECT_NEAR(lowest, -1.0, 1e-12);
+    EXPECT_NEAR(highest, 0.0, 1e-12);
+  }
+  // The same nearly opposite rows with offsets of the polygon's size leave it open.
+  Eigen::MatrixX2d open(3, 2);
+  open << 1, 0, -1, 1e-16, 0, -1;
+  expect_invalid([&] { PaddedPolygon(open, Eigen::Vector3d(1, 1, 1), 0.1); }, "polygon.C");
+}
+
 TEST(Shapes, PolygonRejectsBadRows) {
   expect_invalid([] { PaddedPolygon(Eigen::MatrixX2d(2, 2), Eigen::Vector2d(1, 1), 0.1); },
                  "polygon.C");  // fewer than 3 rows

@@ -41,8 +41,11 @@ class Capsule {
 //   - 0 <= radius <= kMaxMagnitude.
 // Redundant rows (zero rows, rows implied by others, duplicates, rows that cut less than 1e-12 of
 // the polygon's size off) are allowed and dropped. A polygon whose vertex lies more than 1e12
-// times its largest offset from the origin (two consecutive edges within 1e-12 of parallel) is
-// reported as unbounded. The constructor computes the polygon's vertices once, in O(m log m), by
+// times its largest offset from the origin (two consecutive edges within 1e-12 of parallel), or
+// whose vertex the rows fix only to more than 1e-12 of its size (edges within 1e-12 of opposite,
+// unless their offsets are far below the largest: a sliver's apex), is reported as unbounded.
+// Slivers are polygons like any other: "within the tolerance" of a spike is bevelled, never
+// stretched along it. The constructor computes the polygon's vertices once, in O(m log m), by
 // walking the rows in the order of their normals' angles around the origin (which lies inside);
 // the test that drops a row is linear in the offsets, so offsets from 1e-300 to 1e100 are handled
 // alike.

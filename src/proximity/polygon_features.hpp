@@ -63,35 +63,65 @@ class PolygonView : public PolygonBoundary<PolygonView> {
   double scale_;
 };
 
-// Is y in the polygon grown by `slack` (every row n . y <= b + slack)? Polygon is a PolygonView
-// or a SubPolygon (sub_polygon.hpp).
+// The rows of a polygon grown by a slack s meet beyond a vertex of interior angle a at s / sin(a /
+// 2) from it: near a spike (a sliver's apex, a ~ 1e-16) that is far more than s, and "within the
+// tolerance of the polygon" would take in points a whole scene away. So the grown polygon is also
+// cut by a bevel at every vertex where the boundary turns by more than a quarter (its normals n_i,
+// n_{i+1} at more than 90 degrees, a < 90): the row m . y <= m . v_i + s with m the unit bisector
+// of the normals, which passes through the vertex and cuts nothing of the polygon itself. Grown
+// rows and bevels then stay within s sqrt(2) of the polygon. n_i + n_{i+1} is exact where its
+// components cancel (Sterbenz), so m is as accurate as the normals even for a ~1e-16 apex.
+// Returns false where vertex i is no spike.
+template <class Polygon>
+bool spike_bevel(const Polygon& polygon, Eigen::Index i, Eigen::Vector2d& normal, double& offset) {
+  const Eigen::Vector2d n = polygon.normal(i), next = polygon.normal(polygon.next(i));
+  if (!(n.dot(next) < 0.0)) return false;
+  normal = (n + next).normalized();
+  offset = normal.dot(polygon.vertex(i));
+  return true;
+}
+
+// Is y in the polygon grown by `slack` (every row n . y <= b + slack, and every spike's bevel, see
+// above)? Polygon is a PolygonView or a SubPolygon (sub_polygon.hpp).
 template <class Polygon>
 bool contains(const Polygon& polygon, const Eigen::Vector2d& y, double slack) {
   for (Eigen::Index j = 0; j < polygon.size(); ++j) {
     if (polygon.normal(j).dot(y) > polygon.offset(j) + slack) return false;
   }
+  Eigen::Vector2d normal;
+  double offset = 0.0;
+  for (Eigen::Index i = 0; i < polygon.size(); ++i) {
+    if (spike_bevel(polygon, i, normal, offset) && normal.dot(y) > offset + slack) return false;
+  }
   return true;
 }
 
 // The parameter interval {s in [0, 1] : y0 + s w in the polygon grown by `slack`} (Cyrus-Beck
-// clipping); empty when the returned low > high. Each row n.(y0 + s w) <= b + slack bounds s from
-// one side: s <= room / n.w when n.w > 0, from below when n.w < 0; a row parallel to w either
-// holds for every s or for none.
+// clipping, the spikes' bevels included as rows, see above); empty when the returned low > high.
+// Each row n.(y0 + s w) <= b + slack bounds s from one side: s <= room / n.w when n.w > 0, from
+// below when n.w < 0; a row parallel to w either holds for every s or for none.
 template <class Polygon>
 std::array<double, 2> clip_line(const Polygon& polygon, const Eigen::Vector2d& y0,
                                 const Eigen::Vector2d& w, double slack) {
   double low = 0.0, high = 1.0;
-  for (Eigen::Index j = 0; j < polygon.size() && low <= high; ++j) {
-    const Eigen::Vector2d n = polygon.normal(j);
+  const auto clip = [&](const Eigen::Vector2d& n, double offset) {
     const double along = n.dot(w);
-    const double room = polygon.offset(j) + slack - n.dot(y0);
+    const double room = offset + slack - n.dot(y0);
     if (along > 0.0) {
       high = std::min(high, room / along);
     } else if (along < 0.0) {
       low = std::max(low, room / along);
     } else if (room < 0.0) {
-      return {1.0, 0.0};
+      low = 1.0, high = 0.0;
     }
+  };
+  for (Eigen::Index j = 0; j < polygon.size() && low <= high; ++j) {
+    clip(polygon.normal(j), polygon.offset(j));
+  }
+  Eigen::Vector2d normal;
+  double offset = 0.0;
+  for (Eigen::Index i = 0; i < polygon.size() && low <= high; ++i) {
+    if (spike_bevel(polygon, i, normal, offset)) clip(normal, offset);
   }
   return {low, high};
 }

@@ -17,20 +17,37 @@ Eigen::Vector3d lift(const Eigen::Vector2d& y) { return {y.x(), y.y(), 0.0}; }
 // polygon_windows.hpp (measured in bench_proximity: the two cost the same near 32 x 32 vertices).
 constexpr Eigen::Index kEnumerationLimit = Eigen::Index{32} * 32;
 
-// The common region of A and B's shadow when the planes are parallel: B's row n . y_B <= b
-// becomes (R n) . y_A <= b + (R n) . t in A's plane, with y_A = R y_B + t the in-plane part of B's
-// pose in A's frame (a rotation, or a reflection when B faces the other way).
+// A polygon's rows, and the bevels of its spikes (polygon_features.hpp), as half-planes of A's
+// plane: row n . y_B <= b becomes (R n) . y_A <= b + (R n) . t, with y_A = R y_B + t. Returns the
+// number written to `out`, which holds size() + 3 entries: the normals turn by 360 degrees in all,
+// so at most 3 vertices turn by more than 90 and are spikes.
+Eigen::Index shadow_half_planes(const PolygonView& polygon, const Eigen::Matrix2d& rotation,
+                                const Eigen::Vector2d& translation, HalfPlane* out) {
+  Eigen::Index count = 0;
+  const auto add = [&](const Eigen::Vector2d& normal, double offset) {
+    const Eigen::Vector2d turned = rotation * normal;
+    out[count++] = {turned, offset + turned.dot(translation)};
+  };
+  for (Eigen::Index j = 0; j < polygon.size(); ++j) add(polygon.normal(j), polygon.offset(j));
+  Eigen::Vector2d normal;
+  double offset = 0.0;
+  for (Eigen::Index i = 0; i < polygon.size(); ++i) {
+    if (spike_bevel(polygon, i, normal, offset)) add(normal, offset);
+  }
+  return count;
+}
+
+// The common region of A and B's shadow when the planes are parallel: B's rows carried into A's
+// plane by the in-plane part of B's pose in A's frame (a rotation, or a reflection when B faces
+// the other way), each polygon's spikes bevelled so that the slack does not stretch them.
 bool parallel_overlap(const PolygonView& a, const PolygonView& b, const PolygonPairFrame& frame,
                       double tolerance, Eigen::Vector2d& centre) {
-  SmallBuffer<HalfPlane> a_rows(a.size()), b_rows(b.size());
-  for (Eigen::Index j = 0; j < a.size(); ++j) a_rows[j] = {a.normal(j), a.offset(j)};
-  const Eigen::Matrix2d rotation = frame.b_in_a.topLeftCorner<2, 2>();
-  const Eigen::Vector2d translation = frame.b_origin_in_a.head<2>();
-  for (Eigen::Index j = 0; j < b.size(); ++j) {
-    const Eigen::Vector2d normal = rotation * b.normal(j);
-    b_rows[j] = {normal, b.offset(j) + normal.dot(translation)};
-  }
-  return overlap_centre(a_rows.data(), a.size(), a.extent(), b_rows.data(), b.size(), tolerance,
+  SmallBuffer<HalfPlane> a_rows(a.size() + 3), b_rows(b.size() + 3);
+  const Eigen::Index a_count =
+      shadow_half_planes(a, Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero(), a_rows.data());
+  const Eigen::Index b_count = shadow_half_planes(b, frame.b_in_a.topLeftCorner<2, 2>(),
+                                                  frame.b_origin_in_a.head<2>(), b_rows.data());
+  return overlap_centre(a_rows.data(), a_count, a.extent(), b_rows.data(), b_count, tolerance,
                         centre);
 }
 
