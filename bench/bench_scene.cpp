@@ -18,6 +18,7 @@
 //   *_Broadphase/FarBody/n   the same with body 0 moved alone to (1e9, 1e9, 1e9): the other
 //                            centres share one cell of the whole scene's grid (the hierarchy
 //                            must split them in their own bounds).
+//   Scene_Broadphase_TwoExcludedBodies/n   two excluded bodies of n / 2 overlapping capsules.
 //   Scene_Contacts/n         diffpills: Scene::contacts, broadphase and signed distance with the
 //                            gradients with respect to the body poses, margin 0.
 //   Fcl_BroadphaseDistance/n FCL: the same broadphase, then fcl::distance on every pair it reports
@@ -179,6 +180,27 @@ void Scene_Broadphase(benchmark::State& state, bool far_body) {
   state.SetComplexityN(state.range(0));
 }
 
+// Two bodies of n / 2 capsules each, interleaved along a line 1e-3 long (every box overlaps every
+// other), never checked against each other: no pair, and no walk across the bodies.
+void Scene_Broadphase_TwoExcludedBodies(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  std::vector<BodyShape> even, odd;
+  for (int k = 0; k < n; ++k) {
+    const Pose pose(Eigen::Vector3d(1e-3 * k / n, 0, 0), Eigen::Vector4d(1, 0, 0, 0));
+    (k % 2 ? odd : even).push_back({Capsule(1.0, 0.5), pose});
+  }
+  const diffpills::Scene scene({Body("even", even), Body("odd", odd)}, {{"even", "odd"}});
+  const std::vector<Pose> poses(2);
+  const diffpills::detail::SceneOutlines outlines =
+      diffpills::detail::make_outlines(scene.bodies());
+  std::size_t pairs = 0;
+  for (auto _ : state) {
+    pairs = diffpills::detail::broadphase(scene, outlines, poses, 0.0).size();
+    benchmark::DoNotOptimize(pairs);
+  }
+  state.counters["pairs"] = static_cast<double>(pairs);
+}
+
 void Fcl_Broadphase(benchmark::State& state, bool far_body) {
   const BenchScene& s = bench_scene(static_cast<int>(state.range(0)), far_body);
   const std::unique_ptr<FclScene> f = fcl_scene(s);
@@ -227,6 +249,7 @@ BENCHMARK_CAPTURE(Scene_Broadphase, , false)->SCENE_SIZES;
 BENCHMARK_CAPTURE(Fcl_Broadphase, , false)->SCENE_SIZES;
 BENCHMARK_CAPTURE(Scene_Broadphase, FarBody, true)->FAR_BODY_SIZES;
 BENCHMARK_CAPTURE(Fcl_Broadphase, FarBody, true)->FAR_BODY_SIZES;
+BENCHMARK(Scene_Broadphase_TwoExcludedBodies)->Arg(64000)->Unit(benchmark::kMillisecond);
 BENCHMARK(Scene_Contacts)->SCENE_SIZES;
 BENCHMARK(Fcl_BroadphaseDistance)->SCENE_SIZES;
 

@@ -13,8 +13,8 @@ The forward pass is ``diffpills.proximity_batch`` on the CPU in float64; the bac
 multiplies the incoming gradient by the library's exact gradient of phi (no finite differences, no
 second derivatives: the function is once differentiable). Inputs may be float64 or float32, on any
 device; phi comes back in the inputs' dtype and on their device. A result beyond float32's range
-(3.4e38, phi of poses 1e19 apart) raises ValueError naming it instead of turning into inf: use
-float64 inputs for such scenes.
+(3.4e38, phi of poses 1e19 apart), or a gradient that leaves it once summed over shared poses,
+raises ValueError naming it instead of turning into inf: use float64 inputs for such scenes.
 """
 
 import numpy as np
@@ -55,33 +55,88 @@ def _tensor(name, array, like):
     return torch.from_numpy(array).to(**like)
 
 
+_POSE_COLUMNS = {"r_a": slice(0, 3), "q_a": slice(3, 7), "r_b": slice(7, 10), "q_b": slice(10, 14)}
+
+
 class _Batch(torch.autograd.Function):
     """A value of N pose pairs (phi or the signed distance), with backward through the analytic
-    gradient. ``batch`` is the diffpills batch function, called with keyword ``options``."""
+    gradient. ``batch`` is the diffpills batch function, called with keyword ``options``; each pose
+    tensor has N rows or one shared by all N. The gradient stays in float64 until the backward
+    pass has summed it over shared rows, so float32 inputs get a ValueError, not inf, if a sum
+    leaves float32's range."""
 
     @staticmethod
-    def forward(ctx, batch, a, b, options, r_a, q_a, r_b, q_b):
-        value, gradient = batch(
-            a, _as_numpy(r_a), _as_numpy(q_a), b, _as_numpy(r_b), _as_numpy(q_b), **options
-        )
+    def forward(ctx, batch, a, b, options, n, r_a, q_a, r_b, q_b):
+        poses = [
+            np.ascontiguousarray(np.broadcast_to(_as_numpy(t), (n, t.shape[1])))
+            for t in (r_a, q_a, r_b, q_b)
+        ]
+        value, gradient = batch(a, poses[0], poses[1], b, poses[2], poses[3], **options)
         like = {"device": r_a.device, "dtype": r_a.dtype}
-        ctx.save_for_backward(_tensor("gradient", gradient, like))
+        ctx.like = like
+        ctx.shared = [t.shape[0] == 1 and n != 1 for t in (r_a, q_a, r_b, q_b)]
+        ctx.save_for_backward(torch.from_numpy(gradient))
         return _tensor("phi" if batch is _core.proximity_batch else "distance", value, like)
 
     @staticmethod
-    def backward(ctx, grad_phi):
+    def backward(ctx, grad_value):
         _refuse_second_derivatives()
         (gradient,) = ctx.saved_tensors
-        weighted = gradient * grad_phi.unsqueeze(1)
+        weighted = gradient * grad_value.detach().to(device="cpu", dtype=torch.float64).unsqueeze(1)
+        grads = []
+        for (name, columns), shared in zip(_POSE_COLUMNS.items(), ctx.shared):
+            part = weighted[:, columns]
+            if shared:
+                part = part.sum(0, keepdim=True)
+            grads.append(_tensor(f"the gradient of {name}", part.numpy(), ctx.like))
+        return (None, None, None, None, None, *grads)
+
+
+class _SceneContacts(torch.autograd.Function):
+    """The contacts of a scene: distance and phi (K,) differentiable with respect to the body
+    poses r (n, 3), q (n, 4); the rest returned alongside, not differentiable. The gradients are
+    summed per body in float64, as in _Batch."""
+
+    @staticmethod
+    def forward(ctx, scene, margin, r, q):
+        found = scene.contacts(_as_numpy(r), _as_numpy(q), margin)
+        like = {"device": r.device, "dtype": r.dtype}
+        distance = _tensor("distance", found.distance, like)
+        phi = _tensor("phi", found.phi, like)
+        bodies = torch.from_numpy(found.bodies.astype(np.int64))
+        ctx.save_for_backward(
+            bodies, torch.from_numpy(found.gradient), torch.from_numpy(found.phi_gradient)
+        )
+        ctx.like = like
+        ctx.bodies = r.shape[0]
+        others = (
+            bodies.to(device=r.device),
+            torch.from_numpy(found.shapes.astype(np.int64)).to(device=r.device),
+            _tensor("points", found.points, like),
+            torch.from_numpy(found.normal).to(**like),
+            _tensor("gradient", found.gradient, like),
+            _tensor("phi_gradient", found.phi_gradient, like),
+        )
+        ctx.mark_non_differentiable(*others)
+        return (distance, phi) + others
+
+    @staticmethod
+    def backward(ctx, grad_distance, grad_phi, *unused):
+        _refuse_second_derivatives()
+        bodies, gradient, phi_gradient = ctx.saved_tensors
+        cpu64 = {"device": "cpu", "dtype": torch.float64}
+        weighted = gradient * grad_distance.detach().to(**cpu64).unsqueeze(1)
+        weighted += phi_gradient * grad_phi.detach().to(**cpu64).unsqueeze(1)
+        grad_r = weighted.new_zeros(ctx.bodies, 3)
+        grad_q = weighted.new_zeros(ctx.bodies, 4)
+        for side, offset in ((0, 0), (1, 7)):
+            grad_r.index_add_(0, bodies[:, side], weighted[:, offset : offset + 3])
+            grad_q.index_add_(0, bodies[:, side], weighted[:, offset + 3 : offset + 7])
         return (
             None,
             None,
-            None,
-            None,
-            weighted[:, 0:3],
-            weighted[:, 3:7],
-            weighted[:, 7:10],
-            weighted[:, 10:14],
+            _tensor("the gradient of r", grad_r.numpy(), ctx.like),
+            _tensor("the gradient of q", grad_q.numpy(), ctx.like),
         )
 
 
@@ -144,49 +199,7 @@ def _apply(batch, a, b, options, r_a, q_a, r_b, q_b):
             n, n_from = tensor.shape[0], name
         elif tensor.shape[0] != n:
             raise ValueError(f"{name}: has {tensor.shape[0]} rows, {n_from} has {n}")
-    # expand() is a view whose backward sums over the shared rows.
-    r_a, q_a, r_b, q_b = (t.expand(n, t.shape[1]) for t in (r_a, q_a, r_b, q_b))
-    return _Batch.apply(batch, a, b, options, r_a, q_a, r_b, q_b)
-
-
-class _SceneContacts(torch.autograd.Function):
-    """The contacts of a scene: distance and phi (K,) differentiable with respect to the body
-    poses r (n, 3), q (n, 4); the rest returned alongside, not differentiable."""
-
-    @staticmethod
-    def forward(ctx, scene, margin, r, q):
-        found = scene.contacts(_as_numpy(r), _as_numpy(q), margin)
-        like = {"device": r.device, "dtype": r.dtype}
-        bodies = torch.from_numpy(found.bodies.astype(np.int64)).to(device=r.device)
-        ctx.save_for_backward(
-            bodies,
-            _tensor("gradient", found.gradient, like),
-            _tensor("phi_gradient", found.phi_gradient, like),
-        )
-        ctx.bodies = r.shape[0]
-        others = (
-            bodies,
-            torch.from_numpy(found.shapes.astype(np.int64)).to(device=r.device),
-            _tensor("points", found.points, like),
-            torch.from_numpy(found.normal).to(**like),
-            _tensor("gradient", found.gradient, like),
-            _tensor("phi_gradient", found.phi_gradient, like),
-        )
-        ctx.mark_non_differentiable(*others)
-        distance = _tensor("distance", found.distance, like)
-        return (distance, _tensor("phi", found.phi, like)) + others
-
-    @staticmethod
-    def backward(ctx, grad_distance, grad_phi, *unused):
-        _refuse_second_derivatives()
-        bodies, gradient, phi_gradient = ctx.saved_tensors
-        weighted = gradient * grad_distance.unsqueeze(1) + phi_gradient * grad_phi.unsqueeze(1)
-        grad_r = weighted.new_zeros(ctx.bodies, 3)
-        grad_q = weighted.new_zeros(ctx.bodies, 4)
-        for side, offset in ((0, 0), (1, 7)):
-            grad_r.index_add_(0, bodies[:, side], weighted[:, offset : offset + 3])
-            grad_q.index_add_(0, bodies[:, side], weighted[:, offset + 3 : offset + 7])
-        return None, None, grad_r, grad_q
+    return _Batch.apply(batch, a, b, options, n, r_a, q_a, r_b, q_b)
 
 
 def scene_contacts(scene, r, q, margin=0.0):

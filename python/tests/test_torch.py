@@ -132,6 +132,36 @@ def test_float32_results_beyond_its_range_raise_instead_of_inf():
     assert dtorch.scene_contacts(scene, r.double(), torch.stack([q, q]).double(), margin=1e21).phi.item() > 1e39
 
 
+def test_float32_gradients_summed_beyond_its_range_raise_instead_of_inf():
+    # Each row's gradient (2.97e38 in q_a) fits float32; their sum over the shared q_a does not.
+    f = torch.float32
+    long_stick, stick = diffpills.Capsule(3e38, 0.0), diffpills.Capsule(1.0, 0.1)
+    q_a = torch.tensor([1.0, 0.0, 0.0, 0.0], dtype=f, requires_grad=True)
+    r_b = torch.tensor([[1.485e38, 1.0, 0.0]] * 2, dtype=f)
+    identity = torch.tensor([1.0, 0.0, 0.0, 0.0], dtype=f)
+    distance = dtorch.signed_distance(long_stick, torch.zeros(3, dtype=f), q_a, stick, r_b, identity)
+    assert torch.isfinite(distance).all()
+    with pytest.raises(ValueError, match="^the gradient of q_a: .* beyond float32's range"):
+        distance.sum().backward()
+    # In float64 the same sum is finite, and twice one row's.
+    q64 = q_a.detach().double().requires_grad_(True)
+    d64 = dtorch.signed_distance(long_stick, torch.zeros(3).double(), q64, stick, r_b.double(), identity.double())
+    d64.sum().backward()
+    one = diffpills.signed_distance(long_stick, diffpills.Pose(), stick, diffpills.Pose(r_b[0].double().numpy(), [1, 0, 0, 0]))
+    assert np.allclose(q64.grad.numpy(), 2 * one.gradient[3:7], rtol=1e-12)
+    # Through a scene: two long sticks of one body near one stick of another.
+    scene = diffpills.Scene([diffpills.Body("a", [(long_stick, diffpills.Pose())] * 2),
+                             diffpills.Body("b", [(stick, diffpills.Pose())])])
+    r = torch.tensor([[0.0, 0.0, 0.0], [1.485e38, 1.0, 0.0]], dtype=f)
+    q = torch.tensor([[1.0, 0.0, 0.0, 0.0]] * 2, dtype=f, requires_grad=True)
+    contacts = dtorch.scene_contacts(scene, r, q, margin=10.0)
+    with pytest.raises(ValueError, match="^the gradient of q: .* beyond float32's range"):
+        contacts.distance.sum().backward()
+    # A forward pass that needs no gradient is not refused for one.
+    with torch.no_grad():
+        assert torch.isfinite(dtorch.signed_distance(long_stick, torch.zeros(3, dtype=f), identity, stick, r_b, identity)).all()
+
+
 def test_a_pose_refuses_a_tensor_that_requires_grad():
     # A Pose holds plain numbers outside autograd: reading a tensor that requires grad would silently
     # cut it from its graph, so the error says to detach it (or to use diffpills.torch.proximity).

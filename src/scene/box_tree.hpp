@@ -1,24 +1,26 @@
 // The broadphase of a scene query (scene.hpp): which of n axis-aligned boxes overlap, among the
 // pairs a filter allows.
 //
-// A bounding-volume hierarchy is built over the boxes for each query (a linear BVH): the boxes'
-// centres get Morton codes in their bounding box (10 bits per axis, interleaved), are sorted by
-// them (radix sort, O(n)), and each range of codes is split where its first and last codes first
-// differ: the nodes are the cells of an octree over the centres, down to leaves of at most 2 boxes.
-// A range whose codes are all equal but whose centres are not (a cluster far smaller than the
-// whole, beside one far-away box) gets new codes in its own centres' bounding box and is sorted
-// again, so a cluster is split as finely as the rest; a range of identical centres is split in the
-// middle. Bounds come from below, O(n). The tree is then walked against itself: a node's pairs are
-// its two children's own pairs plus the pairs across them, and two nodes whose boxes do not
-// overlap hold no pair across; at a fixed density of boxes that visits about O(n log n) node
-// pairs, plus the pairs found. A box far larger than the rest (a table under many small parts)
-// costs only the pairs it overlaps. Nothing is kept between queries: the tree is a function of the
+// Bounding-volume hierarchies are built over the boxes for each query (linear BVHs): centres get
+// Morton codes in their bounding box (10 bits per axis, interleaved), are sorted by them (radix
+// sort, O(n)), and each range of codes is split where its first and last codes first differ: the
+// nodes are the cells of an octree over the centres, down to leaves of at most 2 boxes. A range
+// whose codes are all equal but whose centres are not (a cluster far smaller than the whole,
+// beside one far-away box) gets new codes in its own bounds and is sorted again, so a cluster is
+// split as finely as the rest. Nothing is kept between queries: the trees are a function of the
 // boxes.
 //
-// Filtering happens during the walk, not after it: each node knows the group of its boxes (if they
-// share one) and the union of their categories and of their masks, and a node pair that can hold
-// no allowed pair is not visited. So the many overlapping primitives of one body, or of bodies
-// whose categories never meet, cost neither time nor memory beyond the tree.
+// Two levels, as the filters are per group (a body): one tree per group over its boxes, and one
+// tree over the groups' bounds, walked against itself. A node pair of that tree is skipped when
+// its boxes do not overlap, when the unions of its groups' categories and masks do not meet, or
+// when both are one group each and groups_checked refuses them; only for two groups that may pair
+// and whose bounds overlap are their trees walked against each other. At a fixed density that
+// visits about O(n log n) node pairs plus the pairs found; a box far larger than the rest (a
+// table under many small parts) costs only the pairs it overlaps; the boxes of one group, or of
+// two groups never checked against each other (an excluded pair of bodies, categories that never
+// meet), cost nothing beyond their trees however much they overlap. What is not pruned: many
+// groups at one place whose filters are all different and pair with none (each group's own filter
+// is known only at the leaves).
 #pragma once
 
 #include <Eigen/Core>
