@@ -22,12 +22,8 @@ std::string to_line(const nlohmann::ordered_json& value) {
   return value.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
-std::string error_answer(std::string message) {
-  if (message.size() > kMaxErrorBytes) {
-    message.resize(kMaxErrorBytes);
-    message += " ...";
-  }
-  return to_line({{"error", std::move(message)}});
+std::string error_answer(const std::string& message) {
+  return to_line({{"error", error_text(message)}});
 }
 
 // Reads the next line of `in` without its '\n', like std::getline, but keeps at most
@@ -58,6 +54,16 @@ bool read_line(std::istream& in, std::string& line) {
 std::string errno_reason() { return errno == 0 ? "" : std::string(": ") + std::strerror(errno); }
 
 }  // namespace
+
+std::string error_text(std::string message) {
+  if (message.size() > kMaxErrorBytes) {
+    message.resize(kMaxErrorBytes);
+    message += " ...";
+  }
+  // nlohmann writes the bytes that are not UTF-8 as U+FFFD; reading its JSON string back gives
+  // the text without the escapes.
+  return nlohmann::json::parse(to_line(message)).get<std::string>();
+}
 
 std::string answer_line(const std::string& line, const std::string& expected, const Answer& answer,
                         bool& ok) {

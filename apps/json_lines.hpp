@@ -29,6 +29,10 @@ constexpr std::size_t kMaxLineBytes = std::size_t{64} << 20;
 // any std::exception) whose message names the field at fault.
 using Answer = std::function<nlohmann::ordered_json(const nlohmann::json&)>;
 
+// An error message as the commands print it: cut at 1,000 bytes, and valid UTF-8 (bytes that are
+// not are replaced by U+FFFD).
+std::string error_text(std::string message);
+
 // Answers one line: answer(the line parsed by parse_json_line) as one line of valid UTF-8 JSON, or
 // {"error": "..."} (bytes that are not UTF-8 are replaced by U+FFFD where an error quotes them, and
 // an error is cut at 1,000 bytes). expected says what the command reads on a line ("a JSON object

@@ -12,6 +12,7 @@
 
 #include "json_io.hpp"
 #include "json_line.hpp"
+#include "json_lines.hpp"
 
 namespace diffpills::app {
 namespace {
@@ -155,7 +156,7 @@ int run_scene_command(const std::vector<std::string>& arguments, std::istream& i
   try {
     scene = load_scene(path);
   } catch (const std::exception& error) {
-    diagnostics << "diffpills scene: " << path << ": " << error.what() << "\n";
+    diagnostics << "diffpills scene: " << path << ": " << error_text(error.what()) << "\n";
     return kMisuse;
   }
   return run_lines(in, out, diagnostics, kSceneLine,

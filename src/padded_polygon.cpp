@@ -21,15 +21,16 @@
 // rows of a 10^5-gon (whose neighbours cut ~2e-9 of its size). If angle(a, c) >= pi (k <= 0), b is
 // needed to close the polygon and always kept.
 //
-// Bounded <=> consecutive kept normals turn by less than pi. The vertex of a turn within 1e-12 of
-// 0 is not fixed by the rows, and is reported as unbounded. The vertex v of a turn within 1e-12
-// of pi, k = sin(turn) <= 1e-12, is fixed only if the rounding of k (a few 1e-16 absolute in
-// n_a x n_c, so |v| 4.4e-16 / k in v) stays below 1e-12 of the polygon's size: a spike of rows
-// whose offsets are far below the largest (x <= 1e-300 and -x + 1e-16 y <= 1e-300 meet at y =
-// 2e-284 in a polygon of size 1; the row y <= 1e-300 between them is dropped as cutting nothing
-// of that size) is a vertex, the same turn between offsets of the polygon's size is not. Vertices
-// more than 1e12 times the largest offset from the origin are reported as unbounded too, since
-// their position is then fixed only to ~1e-4.
+// Bounded <=> consecutive kept normals turn by less than pi. The vertices are computed from the
+// rows as given, not from the unit normals: each row scaled by a power of two (exactly) so that
+// its largest entry is in [1, 2), the 2 x 2 system of two rows solved by Cramer's rule with each
+// determinant a b - c d computed to about one rounding (Kahan's fused multiply-add algorithm).
+// So a vertex is as accurate as the rows fix it, however nearly parallel or opposite they are: a
+// sliver's apex of rows x <= 1e-28 and -x + 1e-16 y <= 1e-28 lies at y = 2e-12, to the last digits
+// (from the unit normals, rounded by 1e-16, it would be off by as much as itself). Vertices more
+// than 1e12 times the largest offset from the origin are reported as unbounded: rows meeting
+// there are almost surely not what was meant, and a polygon's tolerances are relative to its
+// size.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -46,15 +47,21 @@ struct UnitRow {
   Eigen::Vector2d normal;
   double offset = 0.0;
   double angle = 0.0;
+  // The row as given, scaled by a power of two: largest |entry| in [1, 2), for the vertices.
+  Eigen::Vector2d scaled_row;
+  double scaled_offset = 0.0;
 };
 
 // The smallest normalized offset d_i / |C_i| accepted.
 constexpr double kMinOffset = 1e-300;
 
-// Turns (sines, n_a x n_c) at or below this are checked for the vertex they fix (see above), and
-// the rounding of a sine of unit normals: 2 products of rounded unit vectors, 2^-52 each.
-constexpr double kSmallestTurn = 1e-12;
-constexpr double kTurnRounding = 4.4e-16;
+// a b - c d to about one rounding (Kahan's algorithm): c d's rounding error, recovered exactly by
+// a fused multiply-add, is added back, so nearly equal products keep their digits.
+double difference_of_products(double a, double b, double c, double d) {
+  const double cd = c * d;
+  const double error = std::fma(-c, d, cd);  // cd - c d, exactly
+  return std::fma(a, b, -cd) + error;
+}
 
 double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
@@ -78,7 +85,12 @@ bool normalize_row(double c0, double c1, double d, UnitRow& row) {
   row.normal = Eigen::Vector2d(c0 / norm, c1 / norm);
   row.offset = d / norm;
   row.angle = std::atan2(row.normal.y(), row.normal.x());
-  return std::isfinite(row.offset);
+  int exponent = 0;
+  std::frexp(largest, &exponent);  // largest = f 2^exponent, f in [1/2, 1)
+  const double scale = std::ldexp(1.0, 1 - exponent);
+  row.scaled_row = Eigen::Vector2d(c0 * scale, c1 * scale);
+  row.scaled_offset = d * scale;
+  return std::isfinite(row.offset) && std::isfinite(row.scaled_offset);
 }
 
 }  // namespace
@@ -159,22 +171,27 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
     normals_.row(i) = kept[static_cast<std::size_t>(i)].normal.transpose();
     offsets_(i) = kept[static_cast<std::size_t>(i)].offset;
   }
-  // Vertex i joins edges i and i + 1 (v_ac above with a = i, c = i + 1).
+  // Vertex i joins edges i and i + 1: p . y = s for row i and q . y = t for row i + 1 (scaled
+  // rows as given), so y = (s q_y - t p_y, t p_x - s q_x) / (p x q).
   for (Eigen::Index i = 0; i < k; ++i) {
     const UnitRow& a = kept[static_cast<std::size_t>(i)];
     const UnitRow& c = kept[static_cast<std::size_t>((i + 1) % k)];
-    const double turn = cross(a.normal, c.normal);
-    const bool near_pi = a.normal.dot(c.normal) < 0.0;
-    if (!(turn > (near_pi ? 0.0 : kSmallestTurn))) unbounded();
-    const Eigen::Vector2d vertex = (a.offset * Eigen::Vector2d(c.normal.y(), -c.normal.x()) +
-                                    c.offset * Eigen::Vector2d(-a.normal.y(), a.normal.x())) /
-                                   turn;
-    const double distance = std::hypot(vertex.x(), vertex.y());  // no underflow of squares
-    if (turn <= kSmallestTurn && !(distance * (kTurnRounding / turn) <= 1e-12 * largest_offset)) {
-      unbounded();
-    }
+    const Eigen::Vector2d& p = a.scaled_row;
+    const Eigen::Vector2d& q = c.scaled_row;
+    const double s = a.scaled_offset, t = c.scaled_offset;
+    const double determinant = difference_of_products(p.x(), q.y(), p.y(), q.x());
+    if (!(determinant > 0.0)) unbounded();  // the rows turn by pi or more: open
+    // The offsets scaled by the larger one's power of two, exactly (unless the smaller underflows,
+    // when it is negligible beside it), so that an offset of 1e-300 times an entry of 1e-16 is
+    // not a subnormal number that has lost its digits.
+    int exponent = 0;
+    std::frexp(std::max(s, t), &exponent);
+    const double s1 = std::ldexp(s, -exponent), t1 = std::ldexp(t, -exponent);
+    const Eigen::Vector2d vertex(
+        std::ldexp(difference_of_products(s1, q.y(), t1, p.y()) / determinant, exponent),
+        std::ldexp(difference_of_products(t1, p.x(), s1, q.x()) / determinant, exponent));
     vertices_.row(i) = vertex.transpose();
-    extent_ = std::max(extent_, distance);
+    extent_ = std::max(extent_, std::hypot(vertex.x(), vertex.y()));  // no underflow of squares
   }
   if (!(extent_ <= 1e12 * largest_offset)) unbounded();
   if (!(extent_ <= kMaxMagnitude)) {

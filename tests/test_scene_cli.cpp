@@ -197,6 +197,11 @@ TEST(SceneCli, BadSceneFilesAndArgumentsEndWithStatus2) {
   EXPECT_TRUE(mentions(failure({path, "other.json"}), "unexpected argument 'other.json'"));
   EXPECT_TRUE(mentions(failure({path, "--verbose"}), "unexpected argument '--verbose'"));
   EXPECT_TRUE(mentions(file_failure("{"), "malformed JSON"));
+  // Two byte order marks: the message quotes bytes of the second, cut mid-character; it is still
+  // valid UTF-8 (nlohmann's strict dump throws on anything else).
+  const std::string two_marks = file_failure("\xEF\xBB\xBF\xEF\xBB\xBF{}");
+  EXPECT_TRUE(mentions(two_marks, "malformed JSON")) << two_marks;
+  EXPECT_NO_THROW(static_cast<void>(json(two_marks).dump())) << two_marks;
   EXPECT_TRUE(mentions(file_failure(" \n"),
                        ": empty file; expected a JSON object with a field \"bodies\""));
   EXPECT_TRUE(mentions(file_failure("[]"), "scene: must be an object"));

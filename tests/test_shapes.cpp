@@ -160,10 +160,46 @@ TEST(Shapes, AnOrthogonalSliverWithRoundedRowsIsAPolygon) {
     EXPECT_NEAR(lowest, -1.0, 1e-12);
     EXPECT_NEAR(highest, 0.0, 1e-12);
   }
+  // A taller sliver: y <= 1 is loose, rows 0 and 2 meet at the apex y = 2e-20 / 1.2246e-16.
+  const PaddedPolygon tall(C, Eigen::Vector4d(1e-20, 1, 1e-20, 1e-20), 0.0);
+  EXPECT_NEAR(tall.vertices().col(1).maxCoeff(), 2e-20 / C(2, 1), 1e-15 * 2e-20 / C(2, 1));
   // The same nearly opposite rows with offsets of the polygon's size leave it open.
   Eigen::MatrixX2d open(3, 2);
   open << 1, 0, -1, 1e-16, 0, -1;
   expect_invalid([&] { PaddedPolygon(open, Eigen::Vector3d(1, 1, 1), 0.1); }, "polygon.C");
+}
+
+// Spikes x <= e, -x + s y <= e, -y <= 1: the vertices, computed from the rows as given, are the
+// ones solved here by hand, apex (e, 2e / s) and base (-e - s, -1), (e, -1), to a few ulps for
+// every s down to 1e-16 (their unit normals, rounded, would put the apex off by up to itself;
+// e = 1e-28 at s = 1e-16 was refused as unbounded). An apex beyond 1e12 times the largest offset
+// is refused.
+TEST(Shapes, SpikeVerticesAreTheRowsOwn) {
+  for (const double s : {1e-16, 1e-14, 1e-11, 1e-6, 0.1}) {
+    for (const double e : {2e-300, 1e-100, 1e-30, 1e-28, 1e-25, 1e-20, 1e-10}) {
+      if (2 * e / s > 1e12) continue;
+      Eigen::MatrixX2d C(3, 2);
+      C << 1, 0, -1, s, 0, -1;
+      const PaddedPolygon spike(C, Eigen::Vector3d(e, e, 1.0), 0.0);
+      ASSERT_EQ(spike.vertices().rows(), 3) << "s " << s << " e " << e;
+      const Eigen::Matrix<double, 3, 2> expected =
+          (Eigen::Matrix<double, 3, 2>() << e, 2 * e / s, -e - s, -1, e, -1).finished();
+      // The same cycle of vertices, from whichever vertex the reduction starts at.
+      int start = 0;
+      while (start < 3 && spike.vertices()(start, 1) != expected(0, 1)) ++start;
+      ASSERT_LT(start, 3) << "s " << s << " e " << e;
+      for (int v = 0; v < 3; ++v) {
+        for (int k = 0; k < 2; ++k) {
+          EXPECT_NEAR(spike.vertices()((start + v) % 3, k), expected(v, k),
+                      4e-16 * std::abs(expected(v, k)))
+              << "s " << s << " e " << e << " vertex " << v;
+        }
+      }
+    }
+  }
+  Eigen::MatrixX2d C(3, 2);
+  C << 1, 0, -1, 1e-16, 0, -1;
+  expect_invalid([&] { PaddedPolygon(C, Eigen::Vector3d(1e-3, 1e-3, 1.0), 0.0); }, "polygon.C");
 }
 
 TEST(Shapes, PolygonRejectsBadRows) {

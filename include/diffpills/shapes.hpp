@@ -41,14 +41,13 @@ class Capsule {
 //   - 0 <= radius <= kMaxMagnitude.
 // Redundant rows (zero rows, rows implied by others, duplicates, rows that cut less than 1e-12 of
 // the polygon's size off) are allowed and dropped. A polygon whose vertex lies more than 1e12
-// times its largest offset from the origin (two consecutive edges within 1e-12 of parallel), or
-// whose vertex the rows fix only to more than 1e-12 of its size (edges within 1e-12 of opposite,
-// unless their offsets are far below the largest: a sliver's apex), is reported as unbounded.
-// Slivers are polygons like any other: "within the tolerance" of a spike is bevelled, never
-// stretched along it. The constructor computes the polygon's vertices once, in O(m log m), by
-// walking the rows in the order of their normals' angles around the origin (which lies inside);
-// the test that drops a row is linear in the offsets, so offsets from 1e-300 to 1e100 are handled
-// alike.
+// times its largest offset from the origin (nearly parallel or nearly opposite edges meeting far
+// away) is reported as unbounded. Slivers are polygons like any other: their vertices are
+// computed from the rows as given, to the last digits however nearly opposite the edges, and
+// "within the tolerance" of a spike is bevelled, never stretched along it. The constructor
+// computes the polygon's vertices once, in O(m log m), by walking the rows in the order of their
+// normals' angles around the origin (which lies inside); the test that drops a row is linear in
+// the offsets, so offsets from 1e-300 to 1e100 are handled alike.
 class PaddedPolygon {
  public:
   PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d, double radius);
