@@ -273,4 +273,15 @@ Output to_json(const SignedDistanceJacobian& result) {
   return out;
 }
 
+Output to_json(const std::array<ShapeGradient, 2>& shape_gradient) {
+  const auto one = [](const ShapeGradient& gradient) -> Output {
+    if (const auto* capsule = std::get_if<CapsuleShapeGradient>(&gradient)) {
+      return {{"length", capsule->length}, {"radius", capsule->radius}};
+    }
+    const auto& polygon = std::get<PolygonShapeGradient>(gradient);
+    return {{"C", rows(polygon.C)}, {"d", list(polygon.d)}, {"radius", polygon.radius}};
+  };
+  return {{"a", one(shape_gradient[0])}, {"b", one(shape_gradient[1])}};
+}
+
 }  // namespace diffpills::app

@@ -31,7 +31,7 @@ A query:
          "radius": 0.1, "r": [0,0,1], "q": [1,0,0,0]},
    "jacobian": true}
   Optional: "jacobian" (false by default), "method": "default" | "interior_point",
-  "signed_distance" (false by default).
+  "signed_distance" and "shape_gradient" (false by default).
   Quaternions are [w, x, y, z]; a capsule's core lies along its body x axis; a polygon is
   {y : C y <= d} in its body x-y plane with d > 0.
 
@@ -42,8 +42,13 @@ An answer:
    "signed_distance": {"distance": ..., "points": [x~1, x~2], "normal": [...],
      "gradient": [14 numbers: d distance/d(r1, q1, r2, q2)], "core_points": [x1, x2],
      "penetrating": false, "jacobian": 6x14 rows of the points,
-     "core_points_jacobian": 6x14 rows}}   (signed_distance only if asked, its Jacobians
+     "core_points_jacobian": 6x14 rows, "shape_gradient": {...}},
+                                           (signed_distance only if asked, its Jacobians
                                             only with "jacobian")
+   "shape_gradient": {"a": S, "b": S}}   (only if asked; of phi, and of the distance inside
+                                           signed_distance: S = {"length", "radius"} for a
+                                           capsule, {"C": m rows of 2, "d": [m], "radius"} for
+                                           a polygon, rows as given, redundant rows 0)
   The signed distance is the gap between the padded shapes, or minus their penetration depth.
   A line that is not a valid query is answered {"error": "<field>: <what is wrong>"}
   and the following lines are still answered.

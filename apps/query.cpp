@@ -25,7 +25,8 @@ nlohmann::ordered_json answer(const json& query) {
   if (!query.is_object()) {
     throw std::invalid_argument("query: must be " + kQueryLine);
   }
-  static const std::set<std::string> allowed = {"a", "b", "jacobian", "method", "signed_distance"};
+  static const std::set<std::string> allowed = {
+      "a", "b", "jacobian", "method", "shape_gradient", "signed_distance"};
   for (const auto& item : query.items()) {
     if (allowed.count(item.key()) == 0) {
       throw std::invalid_argument(item.key() + ": unknown field");
@@ -38,6 +39,7 @@ nlohmann::ordered_json answer(const json& query) {
   const PosedShape b = parse_posed_shape(query["b"], "b");
   const bool jacobian = flag(query, "jacobian");
   const bool signed_distance = flag(query, "signed_distance");
+  const bool shape_gradient = flag(query, "shape_gradient");
   ProximityOptions options;
   if (query.contains("method")) {
     const json& method = query["method"];
@@ -52,10 +54,18 @@ nlohmann::ordered_json answer(const json& query) {
   nlohmann::ordered_json out =
       jacobian ? to_json(proximity_jacobian(a.shape, a.pose, b.shape, b.pose, options))
                : to_json(proximity(a.shape, a.pose, b.shape, b.pose, options));
+  if (shape_gradient) {
+    out["shape_gradient"] =
+        to_json(proximity_shape_gradient(a.shape, a.pose, b.shape, b.pose, options).shape_gradient);
+  }
   if (signed_distance) {  // (one method: "method" chooses the proximity's solver)
     out["signed_distance"] =
         jacobian ? to_json(signed_distance_jacobian(a.shape, a.pose, b.shape, b.pose))
                  : to_json(diffpills::signed_distance(a.shape, a.pose, b.shape, b.pose));
+    if (shape_gradient) {
+      out["signed_distance"]["shape_gradient"] =
+          to_json(signed_distance_shape_gradient(a.shape, a.pose, b.shape, b.pose).shape_gradient);
+    }
   }
   return out;
 }

@@ -47,6 +47,7 @@ struct UnitRow {
   Eigen::Vector2d normal;
   double offset = 0.0;
   double angle = 0.0;
+  int row = 0;  // its index in C
   // The row as given, scaled by a power of two: largest |entry| in [1, 2), for the vertices.
   Eigen::Vector2d scaled_row;
   double scaled_offset = 0.0;
@@ -119,6 +120,7 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
                        detail::format_number(d(i)) + ")");
     }
     UnitRow unit;
+    unit.row = static_cast<int>(i);
     if (!normalize_row(C(i, 0), C(i, 1), d(i), unit)) continue;
     // Below this the offset is subnormal or zero: the origin would sit on the row's line, and the
     // vertices would lose their digits (a hostile review found 2 C, d = 5e-324 accepted with
@@ -138,7 +140,8 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
 
   // By angle; of rows with the same normal only the tightest can bind.
   std::sort(rows.begin(), rows.end(), [](const UnitRow& a, const UnitRow& b) {
-    return a.angle < b.angle || (a.angle == b.angle && a.offset < b.offset);
+    if (a.angle != b.angle) return a.angle < b.angle;
+    return a.offset < b.offset || (a.offset == b.offset && a.row < b.row);
   });
   rows.erase(std::unique(rows.begin(), rows.end(),
                          [](const UnitRow& a, const UnitRow& b) { return a.angle == b.angle; }),
@@ -166,10 +169,12 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
 
   normals_.resize(k, 2);
   offsets_.resize(k);
+  edge_rows_.resize(k);
   vertices_.resize(k, 2);
   for (Eigen::Index i = 0; i < k; ++i) {
     normals_.row(i) = kept[static_cast<std::size_t>(i)].normal.transpose();
     offsets_(i) = kept[static_cast<std::size_t>(i)].offset;
+    edge_rows_(i) = kept[static_cast<std::size_t>(i)].row;
   }
   // Vertex i joins edges i and i + 1: p . y = s for row i and q . y = t for row i + 1 (scaled
   // rows as given), so y = (s q_y - t p_y, t p_x - s q_x) / (p x q).

@@ -125,6 +125,39 @@ TEST(Cli, SignedDistanceMatchesTheLibrary) {
   expect_error(query_with(kCapsule, kPolygon, R"(, "signed_distance": 1)"), "signed_distance");
 }
 
+// "shape_gradient": true adds the shapes' parameter gradients of phi (DESIGN.md section 3b), and
+// of the distance inside "signed_distance" when both are asked, as the library gives them.
+TEST(Cli, ShapeGradientMatchesTheLibrary) {
+  const json out = answer(
+      query_with(kCapsule, kPolygon, R"(, "shape_gradient": true, "signed_distance": true)"));
+  Eigen::MatrixX2d C(4, 2);
+  C << 1, 0, 0, 1, -1, 0, 0, -1;
+  const Shape capsule = Capsule(2.0, 0.2);
+  const Shape polygon = PaddedPolygon(C, Eigen::Vector4d(1, 1, 1, 1), 0.1);
+  const Pose polygon_pose({0.3, 0.1, 1}, {0.9, 0.1, 0.2, 0});
+  const auto phi = proximity_shape_gradient(capsule, Pose(), polygon, polygon_pose);
+  const auto distance = signed_distance_shape_gradient(capsule, Pose(), polygon, polygon_pose);
+  const auto check = [](const json& got, const std::array<ShapeGradient, 2>& expected) {
+    const auto& a = std::get<CapsuleShapeGradient>(expected[0]);
+    EXPECT_EQ(got["a"]["length"].get<double>(), a.length);
+    EXPECT_EQ(got["a"]["radius"].get<double>(), a.radius);
+    const auto& b = std::get<PolygonShapeGradient>(expected[1]);
+    ASSERT_EQ(got["b"]["C"].size(), 4u);
+    ASSERT_EQ(got["b"]["d"].size(), 4u);
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(got["b"]["d"][i].get<double>(), b.d(i));
+      for (int j = 0; j < 2; ++j) EXPECT_EQ(got["b"]["C"][i][j].get<double>(), b.C(i, j));
+    }
+    EXPECT_EQ(got["b"]["radius"].get<double>(), b.radius);
+  };
+  check(out["shape_gradient"], phi.shape_gradient);
+  check(out["signed_distance"]["shape_gradient"], distance.shape_gradient);
+  EXPECT_FALSE(answer(query_with(kCapsule, kPolygon, R"(, "signed_distance": true)"))
+                   .at("signed_distance")
+                   .contains("shape_gradient"));
+  expect_error(query_with(kCapsule, kPolygon, R"(, "shape_gradient": "yes")"), "shape_gradient");
+}
+
 TEST(Cli, BadInputGetsAnErrorNamingTheField) {
   expect_error("{\"a\": ", "a: malformed JSON");  // the value of "a" is missing
   expect_error("[1, 2]", "query");

@@ -9,6 +9,7 @@
 #include "diffpills/qp/interior_point.hpp"
 #include "diffpills/rotation.hpp"
 #include "diffpills/scene.hpp"
+#include "diffpills/shape_gradient.hpp"
 #include "diffpills/shapes.hpp"
 #include "diffpills/signed_distance.hpp"
 #include "diffpills/version.hpp"

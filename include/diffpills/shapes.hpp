@@ -61,6 +61,9 @@ class PaddedPolygon {
   // their normal: edge_normals() y <= edge_offsets() describes the same polygon.
   const Eigen::MatrixX2d& edge_normals() const { return normals_; }
   const Eigen::VectorXd& edge_offsets() const { return offsets_; }
+  // The row of C each edge comes from (of rows with one normal, the tightest; the first given of
+  // equal ones): edge_normals().row(j) = C.row(edge_rows()(j)) / |C.row(edge_rows()(j))|.
+  const Eigen::VectorXi& edge_rows() const { return edge_rows_; }
   // The k vertices, counterclockwise; vertex i joins edge i and edge i + 1 (mod k).
   const Eigen::MatrixX2d& vertices() const { return vertices_; }
   // max_i |vertex_i|: the radius of the smallest origin-centred disc holding the core, used as the
@@ -73,6 +76,7 @@ class PaddedPolygon {
   double radius_ = 0.0;
   Eigen::MatrixX2d normals_;
   Eigen::VectorXd offsets_;
+  Eigen::VectorXi edge_rows_;
   Eigen::MatrixX2d vertices_;
   double extent_ = 0.0;
 };
