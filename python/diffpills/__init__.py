@@ -12,6 +12,9 @@ Shapes: ``Capsule(length, radius)`` and ``PaddedPolygon(C, d, radius)``, each po
 ``signed_distance(a, pose_a, b, pose_b)``, ``signed_distance_jacobian``, ``signed_distance_batch``
     the signed distance (the gap, or minus the penetration depth) with its exact gradient, which
     keeps a slope where phi is flat (overlapping cores).
+``proximity_shape_gradient(a, pose_a, b, pose_b)``, ``signed_distance_shape_gradient``
+    the same plus ``shape_gradient``: the derivatives with respect to each shape's own parameters
+    (a capsule's length and radius, a polygon's C, d and radius).
 
 ``Body(name, [(shape, pose), ...])`` and ``Scene(bodies, exclude)``
     rigid sets of primitives and scenes of named bodies; ``scene.contacts(r, q, margin)`` returns
@@ -34,17 +37,21 @@ from ._core import (
     Pose,
     Proximity,
     ProximityJacobian,
+    ProximityShapeGradient,
     SignedDistance,
     SignedDistanceJacobian,
+    SignedDistanceShapeGradient,
     Scene,
     SolverError,
     __version__,
     proximity,
     proximity_batch,
     proximity_jacobian,
+    proximity_shape_gradient,
     signed_distance,
     signed_distance_batch,
     signed_distance_jacobian,
+    signed_distance_shape_gradient,
 )
 
 __all__ = [
@@ -55,17 +62,21 @@ __all__ = [
     "Pose",
     "Proximity",
     "ProximityJacobian",
+    "ProximityShapeGradient",
     "SignedDistance",
     "SignedDistanceJacobian",
+    "SignedDistanceShapeGradient",
     "Scene",
     "SolverError",
     "__version__",
     "proximity",
     "proximity_batch",
     "proximity_jacobian",
+    "proximity_shape_gradient",
     "signed_distance",
     "signed_distance_batch",
     "signed_distance_jacobian",
+    "signed_distance_shape_gradient",
 ]
 
 
@@ -90,9 +101,11 @@ for _class in (
     Pose,
     Proximity,
     ProximityJacobian,
+    ProximityShapeGradient,
     Scene,
     SignedDistance,
     SignedDistanceJacobian,
+    SignedDistanceShapeGradient,
 ):
     _class.__reduce_ex__ = _reduce_ex
 del _class

@@ -1,7 +1,7 @@
 # Type stubs for diffpills._core (the pybind11 module), re-exported by the package diffpills.
 # Arrays and numbers must hold real numbers (floats or ints of any width); complex, bool and str
 # raise TypeError at run time.
-from typing import List, Literal, NamedTuple, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Dict, List, Literal, NamedTuple, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -101,6 +101,20 @@ class SignedDistanceJacobian(SignedDistance):
     @property
     def points_jacobian(self) -> np.ndarray: ...
 
+class ProximityShapeGradient(Proximity):
+    @property
+    def shape_gradient(self) -> Tuple[Dict[str, Any], Dict[str, Any]]: ...
+
+class SignedDistanceShapeGradient(SignedDistance):
+    @property
+    def shape_gradient(self) -> Tuple[Dict[str, Any], Dict[str, Any]]: ...
+
+def proximity_shape_gradient(
+    a: Shape, pose_a: Pose, b: Shape, pose_b: Pose, method: Method = "default"
+) -> ProximityShapeGradient: ...
+def signed_distance_shape_gradient(
+    a: Shape, pose_a: Pose, b: Shape, pose_b: Pose
+) -> SignedDistanceShapeGradient: ...
 def signed_distance(a: Shape, pose_a: Pose, b: Shape, pose_b: Pose) -> SignedDistance: ...
 def signed_distance_jacobian(a: Shape, pose_a: Pose, b: Shape, pose_b: Pose) -> SignedDistanceJacobian: ...
 def signed_distance_batch(

@@ -1,6 +1,7 @@
 """PyTorch autograd for diffpills: ``diffpills.torch.proximity`` and
 ``diffpills.torch.signed_distance`` over batches of poses, ``diffpills.torch.scene_contacts`` over
-the bodies of a scene.
+the bodies of a scene, ``diffpills.torch.shape_proximity`` and ``shape_signed_distance`` whose
+shapes' own parameters (lengths, radii, C and d) are tensors too.
 
     import torch, diffpills, diffpills.torch
     capsule = diffpills.Capsule(1.0, 0.2)
@@ -22,7 +23,13 @@ import torch
 
 from . import _core
 
-__all__ = ["proximity", "scene_contacts", "signed_distance"]
+__all__ = [
+    "proximity",
+    "scene_contacts",
+    "shape_proximity",
+    "shape_signed_distance",
+    "signed_distance",
+]
 
 
 def _refuse_second_derivatives():
@@ -180,7 +187,9 @@ def signed_distance(a, r_a, q_a, b, r_b, q_b, threads=0):
     return _apply(_core.signed_distance_batch, a, b, {"threads": threads}, r_a, q_a, r_b, q_b)
 
 
-def _apply(batch, a, b, options, r_a, q_a, r_b, q_b):
+def _pose_rows(r_a, q_a, r_b, q_b):
+    """The four pose tensors as rows, checked, and N: the row count of those that are not a
+    single pose (1 if all are; the largest would make a 0-row batch with a shared pose fail)."""
     r_a, q_a = _rows("r_a", r_a, 3), _rows("q_a", q_a, 4)
     r_b, q_b = _rows("r_b", r_b, 3), _rows("q_b", q_b, 4)
     tensors = {"r_a": r_a, "q_a": q_a, "r_b": r_b, "q_b": q_b}
@@ -189,8 +198,6 @@ def _apply(batch, a, b, options, r_a, q_a, r_b, q_b):
             raise ValueError(f"{name}: expected float64 or float32, got {tensor.dtype}")
         if tensor.dtype != r_a.dtype or tensor.device != r_a.device:
             raise ValueError(f"{name}: dtype and device must match r_a's")
-    # N is the row count of the tensors that are not a single pose (1 if all are): the largest row
-    # count would make a 0-row batch with a shared pose fail, 0 rows against 1.
     n, n_from = 1, None
     for name, tensor in tensors.items():
         if tensor.shape[0] == 1:
@@ -199,7 +206,160 @@ def _apply(batch, a, b, options, r_a, q_a, r_b, q_b):
             n, n_from = tensor.shape[0], name
         elif tensor.shape[0] != n:
             raise ValueError(f"{name}: has {tensor.shape[0]} rows, {n_from} has {n}")
-    return _Batch.apply(batch, a, b, options, n, r_a, q_a, r_b, q_b)
+    return n, (r_a, q_a, r_b, q_b)
+
+
+def _apply(batch, a, b, options, r_a, q_a, r_b, q_b):
+    n, poses = _pose_rows(r_a, q_a, r_b, q_b)
+    return _Batch.apply(batch, a, b, options, n, *poses)
+
+
+_SHAPE_KEYS = {"capsule": ("length", "radius"), "polygon": ("C", "d", "radius")}
+
+
+def _shape_parameters(name, shape, like):
+    """A shape given by tensors: its kind and its tensors in _SHAPE_KEYS order, checked."""
+    if not isinstance(shape, dict):
+        raise TypeError(
+            f"{name}: expected a dict of tensors, {{'length', 'radius'}} or {{'C', 'd', 'radius'}},"
+            f" got {type(shape).__name__}"
+        )
+    kinds = [kind for kind, keys in _SHAPE_KEYS.items() if set(shape) == set(keys)]
+    if not kinds:
+        raise ValueError(
+            f"{name}: expected the keys length, radius (a capsule) or C, d, radius (a polygon), "
+            f"got {sorted(map(str, shape))}"
+        )
+    kind = kinds[0]
+    tensors = []
+    for key in _SHAPE_KEYS[kind]:
+        tensor = shape[key]
+        field = f"{name}[{key!r}]"
+        if not isinstance(tensor, torch.Tensor):
+            raise TypeError(f"{field}: expected a torch.Tensor, got {type(tensor).__name__}")
+        if tensor.dtype != like.dtype or tensor.device != like.device:
+            raise ValueError(f"{field}: dtype and device must match r_a's")
+        tensors.append(tensor)
+    if kind == "polygon":
+        C, d, radius = tensors
+        if C.dim() != 2 or C.shape[1] != 2 or d.dim() != 1 or d.shape[0] != C.shape[0]:
+            raise ValueError(
+                f"{name}: expected C of shape (m, 2) and d of shape (m,), got "
+                f"{tuple(C.shape)} and {tuple(d.shape)}"
+            )
+    for key, tensor in zip(_SHAPE_KEYS[kind], tensors):
+        if key in ("length", "radius") and tensor.numel() != 1:
+            raise ValueError(f"{name}[{key!r}]: expected one number, got shape {tuple(tensor.shape)}")
+    return kind, tensors
+
+
+def _core_shape(name, kind, tensors):
+    values = [_as_numpy(t) for t in tensors]
+    try:
+        if kind == "capsule":
+            return _core.Capsule(float(values[0].item()), float(values[1].item()))
+        return _core.PaddedPolygon(values[0], values[1], float(values[2].item()))
+    except ValueError as error:  # "capsule.length: ..." as "a: capsule.length: ..."
+        raise ValueError(f"{name}: {error}") from None
+
+
+class _ShapePairs(torch.autograd.Function):
+    """A measure of N pose pairs of two shapes whose parameters are tensors, differentiable with
+    respect to the poses and the parameters: one library call per row (shape_gradient.hpp), the
+    gradients summed over the rows in float64."""
+
+    @staticmethod
+    def forward(ctx, query, value_of, kinds, counts, n, *tensors):
+        shape_tensors = tensors[: counts[0] + counts[1]]
+        poses = tensors[counts[0] + counts[1] :]
+        a = _core_shape("a", kinds[0], shape_tensors[: counts[0]])
+        b = _core_shape("b", kinds[1], shape_tensors[counts[0] :])
+        rows = [np.broadcast_to(_as_numpy(t), (n, t.shape[1])) for t in poses]
+        values = np.empty(n)
+        pose_gradients = np.empty((n, 14))
+        shape_gradients = ([], [])
+        for i in range(n):
+            result = query(a, _core.Pose(rows[0][i], rows[1][i]), b, _core.Pose(rows[2][i], rows[3][i]))
+            values[i] = value_of(result)
+            pose_gradients[i] = result.gradient
+            for side in range(2):
+                gradient = result.shape_gradient[side]
+                keys = _SHAPE_KEYS[kinds[side]]
+                shape_gradients[side].append([np.asarray(gradient[key], dtype=np.float64) for key in keys])
+        like = {"device": poses[0].device, "dtype": poses[0].dtype}
+        ctx.like = like
+        ctx.shared = [t.shape[0] == 1 and n != 1 for t in poses]
+        ctx.shape_gradients = shape_gradients
+        ctx.shape_sizes = [[t.shape for t in shape_tensors[: counts[0]]], [t.shape for t in shape_tensors[counts[0] :]]]
+        ctx.save_for_backward(torch.from_numpy(pose_gradients))
+        return _tensor("phi" if value_of is _phi_of else "distance", values, like)
+
+    @staticmethod
+    def backward(ctx, grad_value):
+        _refuse_second_derivatives()
+        (pose_gradient,) = ctx.saved_tensors
+        weights = grad_value.detach().to(device="cpu", dtype=torch.float64)
+        shape_grads = []
+        for side, name in enumerate("ab"):
+            rows = ctx.shape_gradients[side]
+            for k, size in enumerate(ctx.shape_sizes[side]):
+                total = np.zeros(size)
+                for i, row in enumerate(rows):
+                    total = total + float(weights[i]) * row[k].reshape(size)
+                shape_grads.append(
+                    _tensor(f"the gradient of {name}'s parameters", np.asarray(total), ctx.like)
+                )
+        weighted = pose_gradient * weights.unsqueeze(1)
+        pose_grads = []
+        for (name, columns), shared in zip(_POSE_COLUMNS.items(), ctx.shared):
+            part = weighted[:, columns]
+            if shared:
+                part = part.sum(0, keepdim=True)
+            pose_grads.append(_tensor(f"the gradient of {name}", part.numpy(), ctx.like))
+        return (None, None, None, None, None, *shape_grads, *pose_grads)
+
+
+def _phi_of(result):
+    return result.phi
+
+
+def _distance_of(result):
+    return result.distance
+
+
+def shape_proximity(a, r_a, q_a, b, r_b, q_b, method="default"):
+    """phi (N,) of two shapes whose parameters are tensors, differentiable with respect to them
+    as well as to the poses: for fitting and designing shapes.
+
+    a, b: dicts of tensors, ``{"length": (), "radius": ()}`` for a capsule or ``{"C": (m, 2),
+    "d": (m,), "radius": ()}`` for a padded polygon (C y <= d in its body x-y plane).
+    r_a, q_a, r_b, q_b: poses as for ``proximity`` (single poses shared by all rows allowed).
+    Every tensor shares r_a's dtype (float64 or float32) and device. The gradients are the
+    library's exact ones (shape_gradient.hpp, by the envelope theorem); the rows are computed one
+    library call each, for fitting a few shapes, not for millions of pairs (use ``proximity``).
+    """
+    return _apply_shapes(
+        lambda *args: _core.proximity_shape_gradient(*args, method=method), _phi_of,
+        a, r_a, q_a, b, r_b, q_b,
+    )
+
+
+def shape_signed_distance(a, r_a, q_a, b, r_b, q_b):
+    """The signed distance (N,) of two shapes whose parameters are tensors, differentiable with
+    respect to them and to the poses; arguments as for ``shape_proximity``."""
+    return _apply_shapes(
+        _core.signed_distance_shape_gradient, _distance_of, a, r_a, q_a, b, r_b, q_b
+    )
+
+
+def _apply_shapes(query, value_of, a, r_a, q_a, b, r_b, q_b):
+    n, poses = _pose_rows(r_a, q_a, r_b, q_b)
+    kind_a, tensors_a = _shape_parameters("a", a, poses[0])
+    kind_b, tensors_b = _shape_parameters("b", b, poses[0])
+    counts = (len(tensors_a), len(tensors_b))
+    return _ShapePairs.apply(
+        query, value_of, (kind_a, kind_b), counts, n, *tensors_a, *tensors_b, *poses
+    )
 
 
 def scene_contacts(scene, r, q, margin=0.0):

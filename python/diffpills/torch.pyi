@@ -1,5 +1,5 @@
 # Type stubs for diffpills.torch.
-from typing import Literal
+from typing import Dict, Literal
 
 import torch
 
@@ -27,3 +27,20 @@ def signed_distance(
 def scene_contacts(
     scene: Scene, r: torch.Tensor, q: torch.Tensor, margin: float = 0.0
 ) -> Contacts: ...
+def shape_proximity(
+    a: Dict[str, torch.Tensor],
+    r_a: torch.Tensor,
+    q_a: torch.Tensor,
+    b: Dict[str, torch.Tensor],
+    r_b: torch.Tensor,
+    q_b: torch.Tensor,
+    method: Literal["default", "interior_point"] = "default",
+) -> torch.Tensor: ...
+def shape_signed_distance(
+    a: Dict[str, torch.Tensor],
+    r_a: torch.Tensor,
+    q_a: torch.Tensor,
+    b: Dict[str, torch.Tensor],
+    r_b: torch.Tensor,
+    q_b: torch.Tensor,
+) -> torch.Tensor: ...

@@ -37,9 +37,11 @@ inline std::string not_constructed(const py::handle& object) {
   const std::string type = py::str(py::type::of(object).attr("__name__"));
   return "this diffpills." + type + " was made by __new__ without __init__ and holds no value; " +
          (py::isinstance<Proximity>(object)
-              ? "results come from diffpills.proximity and proximity_jacobian"
+              ? "results come from diffpills.proximity, proximity_jacobian and "
+                "proximity_shape_gradient"
           : py::isinstance<SignedDistance>(object)
-              ? "results come from diffpills.signed_distance and signed_distance_jacobian"
+              ? "results come from diffpills.signed_distance, signed_distance_jacobian and "
+                "signed_distance_shape_gradient"
               : "create it as diffpills." + type + "(...)");
 }
 
@@ -80,6 +82,12 @@ class type_caster<diffpills::SignedDistance>
 template <>
 class type_caster<diffpills::SignedDistanceJacobian>
     : public diffpills::python::ConstructedCaster<diffpills::SignedDistanceJacobian> {};
+template <>
+class type_caster<diffpills::ProximityShapeGradient>
+    : public diffpills::python::ConstructedCaster<diffpills::ProximityShapeGradient> {};
+template <>
+class type_caster<diffpills::SignedDistanceShapeGradient>
+    : public diffpills::python::ConstructedCaster<diffpills::SignedDistanceShapeGradient> {};
 template <>
 class type_caster<diffpills::Body> : public diffpills::python::ConstructedCaster<diffpills::Body> {
 };
@@ -566,6 +574,112 @@ points_jacobian       (6, 14): d[surface point a; surface point b] / d[r_a, q_a,
           }));
 }
 
+// A shape's parameter gradient as Python sees it: {"length", "radius"} for a capsule, {"C" (m, 2),
+// "d" (m,), "radius"} for a polygon.
+py::dict shape_gradient_dict(const ShapeGradient& gradient) {
+  py::dict out;
+  if (const auto* capsule = std::get_if<CapsuleShapeGradient>(&gradient)) {
+    out["length"] = capsule->length;
+    out["radius"] = capsule->radius;
+    return out;
+  }
+  const auto& polygon = std::get<PolygonShapeGradient>(gradient);
+  out["C"] = py::cast(Eigen::MatrixX2d(polygon.C));
+  out["d"] = py::cast(Eigen::VectorXd(polygon.d));
+  out["radius"] = polygon.radius;
+  return out;
+}
+
+py::tuple shape_gradient_pair(const std::array<ShapeGradient, 2>& gradients) {
+  return py::make_tuple(shape_gradient_dict(gradients[0]), shape_gradient_dict(gradients[1]));
+}
+
+// The dict back, for unpickling, with the checks of any argument.
+ShapeGradient shape_gradient_from(const py::handle& value, const std::string& name) {
+  if (!py::isinstance<py::dict>(value)) {
+    throw py::type_error(name + ": expected a dict, got " + type_name(value));
+  }
+  const py::dict dict = py::reinterpret_borrow<py::dict>(value);
+  const auto field = [&](const char* key) {
+    if (!dict.contains(key)) throw py::value_error(name + "." + key + ": missing");
+    return dict[key];
+  };
+  if (dict.contains("length")) {
+    if (py::len(dict) != 2) throw py::value_error(name + ": expected the keys length, radius");
+    return CapsuleShapeGradient{real_number(field("length"), name + ".length"),
+                                real_number(field("radius"), name + ".radius")};
+  }
+  if (py::len(dict) != 3) throw py::value_error(name + ": expected the keys C, d, radius");
+  const Array C = as_array(field("C"), name + ".C"), d = as_array(field("d"), name + ".d");
+  if (C.ndim() != 2 || C.shape(1) != 2 || d.ndim() != 1 || d.shape(0) != C.shape(0)) {
+    throw py::value_error(name + ": expected C of shape (m, 2) and d of shape (m,), got " +
+                          shape_of(C) + " and " + shape_of(d));
+  }
+  PolygonShapeGradient out{Eigen::MatrixX2d(C.shape(0), 2), Eigen::VectorXd(d.shape(0)),
+                           real_number(field("radius"), name + ".radius")};
+  for (py::ssize_t i = 0; i < C.shape(0); ++i) {
+    out.C(i, 0) = C.at(i, 0);
+    out.C(i, 1) = C.at(i, 1);
+    out.d(i) = d.at(i);
+  }
+  return out;
+}
+
+constexpr const char* kShapeGradientHelp = R"(
+shape_gradient  (a's, b's): for a capsule {"length": ..., "radius": ...}, for a polygon
+                {"C": (m, 2), "d": (m,), "radius": ...}, the derivatives with respect to the
+                shape's own parameters, rows as given (a redundant row gets 0))";
+
+void bind_shape_gradient_results(py::module_& m) {
+  py::class_<ProximityShapeGradient, Proximity>(
+      m, "ProximityShapeGradient",
+      (std::string("The result of diffpills.proximity_shape_gradient: everything of Proximity, "
+                   "plus\n") +
+       kShapeGradientHelp + " (of phi).")
+          .c_str())
+      .def_property_readonly(
+          "shape_gradient",
+          [](const ProximityShapeGradient& p) { return shape_gradient_pair(p.shape_gradient); })
+      .def(py::pickle(
+          [](const ProximityShapeGradient& p) -> py::object {
+            return py::make_tuple(proximity_state(p), shape_gradient_pair(p.shape_gradient));
+          },
+          [](const py::object& state) {
+            const py::tuple fields =
+                pickled_state(state, 2, std::string("(") + kProximityFields + ", shape_gradient)");
+            ProximityShapeGradient p;
+            restore_proximity(p, fields[0]);
+            const py::tuple pair = pickled_state(fields[1], 2, "(a's, b's)");
+            p.shape_gradient = {shape_gradient_from(pair[0], "shape_gradient[0]"),
+                                shape_gradient_from(pair[1], "shape_gradient[1]")};
+            return p;
+          }));
+  py::class_<SignedDistanceShapeGradient, SignedDistance>(
+      m, "SignedDistanceShapeGradient",
+      (std::string("The result of diffpills.signed_distance_shape_gradient: everything of "
+                   "SignedDistance, plus\n") +
+       kShapeGradientHelp + " (of the distance).")
+          .c_str())
+      .def_property_readonly("shape_gradient",
+                             [](const SignedDistanceShapeGradient& s) {
+                               return shape_gradient_pair(s.shape_gradient);
+                             })
+      .def(py::pickle(
+          [](const SignedDistanceShapeGradient& s) -> py::object {
+            return py::make_tuple(signed_distance_state(s), shape_gradient_pair(s.shape_gradient));
+          },
+          [](const py::object& state) {
+            const py::tuple fields = pickled_state(
+                state, 2, std::string("(") + kSignedDistanceFields + ", shape_gradient)");
+            SignedDistanceShapeGradient s;
+            restore_signed_distance(s, fields[0]);
+            const py::tuple pair = pickled_state(fields[1], 2, "(a's, b's)");
+            s.shape_gradient = {shape_gradient_from(pair[0], "shape_gradient[0]"),
+                                shape_gradient_from(pair[1], "shape_gradient[1]")};
+            return s;
+          }));
+}
+
 void bind_results(py::module_& m) {
   py::class_<Proximity>(m, "Proximity", R"(The result of diffpills.proximity.
 
@@ -622,6 +736,7 @@ points_jacobian       (6, 14): d[surface point a; surface point b] / d[r_a, q_a,
             return p;
           }));
   bind_signed_distance_results(m);
+  bind_shape_gradient_results(m);
 }
 
 // A query of two shapes of any type: call(shape_a, pose_a, shape_b, pose_b).
@@ -1121,6 +1236,35 @@ gradient (14,) = d distance / d[r_a, q_a, r_b, q_b].)");
       },
       py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
       R"(As signed_distance, plus core_points_jacobian and points_jacobian (6, 14).)");
+  m.def(
+      "proximity_shape_gradient",
+      [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
+         const py::handle& pose_b, const py::handle& method) {
+        const ProximityOptions options{to_method(method)};
+        return pair_query<ProximityShapeGradient>(
+            a, pose_a, b, pose_b,
+            [&](const auto& x, const Pose& px, const auto& y, const Pose& py_) {
+              return proximity_shape_gradient(Shape(x), px, Shape(y), py_, options);
+            });
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
+      py::arg("method") = "default",
+      R"(As proximity, plus shape_gradient: the derivatives of phi with respect to each shape's own
+parameters, ({"length", "radius"} of a capsule, {"C" (m, 2), "d" (m,), "radius"} of a polygon;
+rows as given, a redundant row 0), by the envelope theorem.)");
+  m.def(
+      "signed_distance_shape_gradient",
+      [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
+         const py::handle& pose_b) {
+        return pair_query<SignedDistanceShapeGradient>(
+            a, pose_a, b, pose_b,
+            [](const auto& x, const Pose& px, const auto& y, const Pose& py_) {
+              return signed_distance_shape_gradient(Shape(x), px, Shape(y), py_);
+            });
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
+      R"(As signed_distance, plus shape_gradient: the derivatives of the distance with respect to
+each shape's own parameters (as proximity_shape_gradient).)");
   m.def("signed_distance_batch", &signed_distance_batch_of, py::arg("a"), py::arg("r_a"),
         py::arg("q_a"), py::arg("b"), py::arg("r_b"), py::arg("q_b"), py::arg("threads") = 0,
         py::arg("out") = py::none(),
