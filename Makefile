@@ -49,10 +49,12 @@ fuzz: fuzz-build
 # The motion-planning demo (car-bus, quadrotor-window and arm-shelf problems: out/*.csv, *.json,
 # *.svg), then
 # the Python example that untangles a 3-D heap of crossing shapes with the signed distance
-# (out/untangle_{before,after}.png).
+# (out/untangle_{before,after}.png), and the one that fits capsules and a padded square to an
+# L-shaped bracket through the shape-parameter gradients (out/fit.svg).
 demo: build
 	./$(BUILD)/examples/diffpills_demo out
 	PYTHONPATH=$(BUILD)/python MPLBACKEND=Agg $(PYTHON) examples/python/untangle.py out
+	PYTHONPATH=$(BUILD)/python $(PYTHON) examples/python/fit_bracket.py out
 
 bench: build
 	./$(BUILD)/bench/bench_proximity --benchmark_min_time=0.2
