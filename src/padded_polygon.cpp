@@ -8,18 +8,17 @@
 // origin; it starts at the row nearest the origin, which always has an edge (the point b n of
 // that row satisfies every other row: n_j . b n <= b <= b_j).
 //
-// The redundancy test. For rows a, b, c in angular order with 0 < angle(a, c) < pi, the lines of a
-// and c meet at the vertex (Cramer's rule)
-//   v_ac = (b_a [n_c,y, -n_c,x] + b_c [-n_a,y, n_a,x]) / k,   k = n_a x n_c = sin angle(a, c),
-// and row b cuts that vertex off by n_b . v_ac - b_b = E / k with
-//   E = b_a (n_b x n_c) + b_c (n_a x n_b) - b_b (n_a x n_c).
-// E is linear in the offsets: no product of two lengths is ever formed, so the test means the same
-// for offsets of 1e-95 and of 1e100 (a dual formulation, through the points n_i / b_i, squares
-// 1 / b and underflows or overflows at either end). Row b is kept when it cuts more than 1e-12 of
-// the polygon's size off: E > 1e-12 k max_i b_i. That drops exact and rounded duplicates (a row
-// given twice at different scales), rows through an existing vertex, and loose rows, and keeps the
-// rows of a 10^5-gon (whose neighbours cut ~2e-9 of its size). If angle(a, c) >= pi (k <= 0), b is
-// needed to close the polygon and always kept.
+// The redundancy test. For rows a, b, c in angular order with 0 < angle(a, c) < pi, row b cuts
+// the vertex of a and c off by E / (k |C_b|) (row_predicates.hpp: k = C_a x C_c, E linear in
+// the offsets, so no product of two lengths is formed and offsets of 1e-300 and 1e100 mean the
+// same). Both are computed on the rows as given (scaled by powers of two, exactly), with their
+// signs exact: the unit normals, rounded, decided nearly parallel and nearly opposite rows by
+// noise. If k <= 0, b is needed to close the polygon and kept. The walk runs twice: first keeping
+// every row that cuts anything (E > 0), which gives the polygon exactly up to the rounding of its
+// vertices and so its size; then dropping the rows that cut less than 1e-12 of that size off
+// (exact and rounded duplicates, rows through a vertex), and keeping the rows of a 10^5-gon
+// (whose neighbours cut ~2e-9 of its size). A loose row far away (offset 1e13 beside a unit
+// square) sets nothing: the tolerance is the polygon's size, not the largest offset's.
 //
 // Bounded <=> consecutive kept normals turn by less than pi. The vertices are computed from the
 // rows as given, not from the unit normals: each row scaled by a power of two (exactly) so that
@@ -28,9 +27,9 @@
 // So a vertex is as accurate as the rows fix it, however nearly parallel or opposite they are: a
 // sliver's apex of rows x <= 1e-28 and -x + 1e-16 y <= 1e-28 lies at y = 2e-12, to the last digits
 // (from the unit normals, rounded by 1e-16, it would be off by as much as itself). Vertices more
-// than 1e12 times the largest offset from the origin are reported as unbounded: rows meeting
-// there are almost surely not what was meant, and a polygon's tolerances are relative to its
-// size.
+// than 1e12 times the largest offset of any row given from the origin are reported as unbounded:
+// rows meeting there are almost surely not what was meant, and a polygon's tolerances are relative
+// to its size.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -38,6 +37,7 @@
 #include <vector>
 
 #include "diffpills/shapes.hpp"
+#include "row_predicates.hpp"
 #include "validation.hpp"
 
 namespace diffpills {
@@ -46,7 +46,6 @@ namespace {
 struct UnitRow {
   Eigen::Vector2d normal;
   double offset = 0.0;
-  double angle = 0.0;
   int row = 0;  // its index in C
   // The row as given, scaled by a power of two: largest |entry| in [1, 2), for the vertices.
   Eigen::Vector2d scaled_row;
@@ -64,17 +63,89 @@ double difference_of_products(double a, double b, double c, double d) {
   return std::fma(a, b, -cd) + error;
 }
 
-double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  return a.x() * b.y() - a.y() * b.x();
+// The vertex of rows a and c (a x c > 0): p . y = s and q . y = t for the scaled rows as given,
+// so y = (s q_y - t p_y, t p_x - s q_x) / (p x q), each determinant to about one rounding. The
+// offsets are scaled by the larger one's power of two, exactly (unless the smaller underflows,
+// when it is negligible beside it), so that an offset of 1e-300 times an entry of 1e-16 is not a
+// subnormal number that has lost its digits.
+Eigen::Vector2d vertex_of(const UnitRow& a, const UnitRow& c) {
+  const Eigen::Vector2d& p = a.scaled_row;
+  const Eigen::Vector2d& q = c.scaled_row;
+  const double determinant = difference_of_products(p.x(), q.y(), p.y(), q.x());
+  int exponent = 0;
+  std::frexp(std::max(a.scaled_offset, c.scaled_offset), &exponent);
+  const double s = std::ldexp(a.scaled_offset, -exponent);
+  const double t = std::ldexp(c.scaled_offset, -exponent);
+  return {std::ldexp(difference_of_products(s, q.y(), t, p.y()) / determinant, exponent),
+          std::ldexp(difference_of_products(t, p.x(), s, q.x()) / determinant, exponent)};
 }
 
-// Row b's cut E (see above) of the vertex of rows a and c, times 1 / (k max_b).
-bool cuts_vertex(const UnitRow& a, const UnitRow& b, const UnitRow& c, double largest_offset) {
-  const double k = cross(a.normal, c.normal);
-  if (k <= 0.0) return true;  // a and c alone leave the polygon open: b closes it
-  const double cut =
-      a.offset * cross(b.normal, c.normal) + c.offset * cross(a.normal, b.normal) - b.offset * k;
-  return cut > 1e-12 * k * largest_offset;
+double distance_to_segment(const Eigen::Vector2d& point, const Eigen::Vector2d& start,
+                           const Eigen::Vector2d& end) {
+  const Eigen::Vector2d along = end - start;
+  const double length_squared = along.squaredNorm();
+  const double t = length_squared > 0.0
+                       ? std::clamp((point - start).dot(along) / length_squared, 0.0, 1.0)
+                       : 0.0;
+  const Eigen::Vector2d gap = point - (start + t * along);
+  return std::hypot(gap.x(), gap.y());
+}
+
+// Is row b needed beside its neighbours a and c: does it close the polygon (a and c turn by pi or
+// more), or cut anything off (tolerance 0), or cut off more than `tolerance`? What b cuts off is
+// the triangle of the vertices v_ab, v_ac, v_bc, as far from the rest as v_ac is from the edge
+// v_ab v_bc: more than v_ac's distance beyond b's line where b is nearly parallel to a or c (a
+// needle's tip 1e-15 beyond the line of a row 6e-11 rad from its side is 4.5e-5 from the rest).
+bool needed(const UnitRow& a, const UnitRow& b, const UnitRow& c, double tolerance) {
+  if (detail::turn(a.scaled_row, c.scaled_row).sign <= 0) return true;
+  const detail::SignedValue e = detail::cut(a.scaled_row, a.scaled_offset, b.scaled_row,
+                                            b.scaled_offset, c.scaled_row, c.scaled_offset);
+  if (e.sign <= 0) return false;
+  if (tolerance == 0.0) return true;
+  return distance_to_segment(vertex_of(a, c), vertex_of(a, b), vertex_of(b, c)) > tolerance;
+}
+
+// The rows that bound the polygon, of `rows` in angular order starting at one that does (a Graham
+// scan around the origin, closing on the first row again, then checking the first and last rows
+// against each other until neither can go).
+std::vector<UnitRow> bounding_rows(const std::vector<UnitRow>& rows, double tolerance) {
+  std::vector<UnitRow> kept;
+  kept.reserve(rows.size());
+  for (std::size_t i = 0; i <= rows.size(); ++i) {
+    const UnitRow& next = rows[i % rows.size()];
+    while (kept.size() >= 2 && !needed(kept[kept.size() - 2], kept.back(), next, tolerance)) {
+      kept.pop_back();
+    }
+    if (i < rows.size()) kept.push_back(next);
+  }
+  for (bool changed = true; changed && kept.size() >= 3;) {
+    changed = false;
+    if (!needed(kept[kept.size() - 2], kept.back(), kept.front(), tolerance)) {
+      kept.pop_back();
+      changed = true;
+    } else if (!needed(kept.back(), kept.front(), kept[1], tolerance)) {
+      kept.erase(kept.begin());
+      changed = true;
+    }
+  }
+  return kept;
+}
+
+// The vertices of consecutive rows (vertex i joins rows i and i + 1), and their largest distance
+// from the origin; false if two consecutive rows turn by pi or more (the polygon is open).
+bool vertices_of(const std::vector<UnitRow>& kept, Eigen::MatrixX2d& vertices, double& extent) {
+  const auto k = static_cast<Eigen::Index>(kept.size());
+  vertices.resize(k, 2);
+  extent = 0.0;
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const UnitRow& a = kept[static_cast<std::size_t>(i)];
+    const UnitRow& c = kept[static_cast<std::size_t>((i + 1) % k)];
+    if (detail::turn(a.scaled_row, c.scaled_row).sign <= 0) return false;
+    const Eigen::Vector2d vertex = vertex_of(a, c);
+    vertices.row(i) = vertex.transpose();
+    extent = std::max(extent, std::hypot(vertex.x(), vertex.y()));  // no underflow of squares
+  }
+  return true;
 }
 
 // The row C y <= d as n . y <= b with |n| = 1; false for a row that constrains nothing (C = 0, or
@@ -85,7 +156,6 @@ bool normalize_row(double c0, double c1, double d, UnitRow& row) {
   const double norm = std::hypot(c0, c1);  // no overflow or underflow, unlike sqrt(c0^2 + c1^2)
   row.normal = Eigen::Vector2d(c0 / norm, c1 / norm);
   row.offset = d / norm;
-  row.angle = std::atan2(row.normal.y(), row.normal.x());
   int exponent = 0;
   std::frexp(largest, &exponent);  // largest = f 2^exponent, f in [1/2, 1)
   const double scale = std::ldexp(1.0, 1 - exponent);
@@ -138,65 +208,46 @@ PaddedPolygon::PaddedPolygon(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d
   };
   if (rows.size() < 3) unbounded();
 
-  // By angle; of rows with the same normal only the tightest can bind.
-  std::sort(rows.begin(), rows.end(), [](const UnitRow& a, const UnitRow& b) {
-    if (a.angle != b.angle) return a.angle < b.angle;
+  // By the angle of the normal, exactly (the half-plane of the direction, then the sign of the
+  // turn between two); of rows with one normal only the tightest can bind.
+  const auto half = [](const Eigen::Vector2d& p) {
+    return p.y() > 0.0 || (p.y() == 0.0 && p.x() > 0.0) ? 0 : 1;
+  };
+  const auto same_direction = [&](const UnitRow& a, const UnitRow& b) {
+    return half(a.scaled_row) == half(b.scaled_row) &&
+           detail::turn(a.scaled_row, b.scaled_row).sign == 0;
+  };
+  std::sort(rows.begin(), rows.end(), [&](const UnitRow& a, const UnitRow& b) {
+    if (half(a.scaled_row) != half(b.scaled_row)) return half(a.scaled_row) < half(b.scaled_row);
+    const int turn = detail::turn(a.scaled_row, b.scaled_row).sign;
+    if (turn != 0) return turn > 0;
     return a.offset < b.offset || (a.offset == b.offset && a.row < b.row);
   });
-  rows.erase(std::unique(rows.begin(), rows.end(),
-                         [](const UnitRow& a, const UnitRow& b) { return a.angle == b.angle; }),
-             rows.end());
-  double largest_offset = 0.0;
+  rows.erase(std::unique(rows.begin(), rows.end(), same_direction), rows.end());
+  // The walk starts at the row nearest the origin, which has an edge (the point b n of that row
+  // satisfies every other row: n_j . b n <= b <= b_j); should rounding pick a row that has none,
+  // the walk's closing check drops it.
   std::size_t nearest = 0;
+  double largest_offset = 0.0;  // of every row given: the scale a far vertex is measured against
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    largest_offset = std::max(largest_offset, rows[i].offset);
     if (rows[i].offset < rows[nearest].offset) nearest = i;
+    largest_offset = std::max(largest_offset, rows[i].offset);
   }
   std::rotate(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(nearest), rows.end());
 
-  std::vector<UnitRow> kept;
-  kept.reserve(rows.size());
-  for (std::size_t i = 0; i <= rows.size(); ++i) {
-    const UnitRow& next = rows[i % rows.size()];  // the walk closes on the first row again
-    while (kept.size() >= 2 &&
-           !cuts_vertex(kept[kept.size() - 2], kept.back(), next, largest_offset)) {
-      kept.pop_back();
-    }
-    if (i < rows.size()) kept.push_back(next);
-  }
+  // Every row that cuts anything, for the polygon's size; then those that cut 1e-12 of it.
+  std::vector<UnitRow> kept = bounding_rows(rows, 0.0);
+  if (kept.size() < 3 || !vertices_of(kept, vertices_, extent_)) unbounded();
+  kept = bounding_rows(kept, 1e-12 * extent_);
+  if (kept.size() < 3 || !vertices_of(kept, vertices_, extent_)) unbounded();
   const auto k = static_cast<Eigen::Index>(kept.size());
-  if (k < 3) unbounded();
-
   normals_.resize(k, 2);
   offsets_.resize(k);
   edge_rows_.resize(k);
-  vertices_.resize(k, 2);
   for (Eigen::Index i = 0; i < k; ++i) {
     normals_.row(i) = kept[static_cast<std::size_t>(i)].normal.transpose();
     offsets_(i) = kept[static_cast<std::size_t>(i)].offset;
     edge_rows_(i) = kept[static_cast<std::size_t>(i)].row;
-  }
-  // Vertex i joins edges i and i + 1: p . y = s for row i and q . y = t for row i + 1 (scaled
-  // rows as given), so y = (s q_y - t p_y, t p_x - s q_x) / (p x q).
-  for (Eigen::Index i = 0; i < k; ++i) {
-    const UnitRow& a = kept[static_cast<std::size_t>(i)];
-    const UnitRow& c = kept[static_cast<std::size_t>((i + 1) % k)];
-    const Eigen::Vector2d& p = a.scaled_row;
-    const Eigen::Vector2d& q = c.scaled_row;
-    const double s = a.scaled_offset, t = c.scaled_offset;
-    const double determinant = difference_of_products(p.x(), q.y(), p.y(), q.x());
-    if (!(determinant > 0.0)) unbounded();  // the rows turn by pi or more: open
-    // The offsets scaled by the larger one's power of two, exactly (unless the smaller underflows,
-    // when it is negligible beside it), so that an offset of 1e-300 times an entry of 1e-16 is
-    // not a subnormal number that has lost its digits.
-    int exponent = 0;
-    std::frexp(std::max(s, t), &exponent);
-    const double s1 = std::ldexp(s, -exponent), t1 = std::ldexp(t, -exponent);
-    const Eigen::Vector2d vertex(
-        std::ldexp(difference_of_products(s1, q.y(), t1, p.y()) / determinant, exponent),
-        std::ldexp(difference_of_products(t1, p.x(), s1, q.x()) / determinant, exponent));
-    vertices_.row(i) = vertex.transpose();
-    extent_ = std::max(extent_, std::hypot(vertex.x(), vertex.y()));  // no underflow of squares
   }
   if (!(extent_ <= 1e12 * largest_offset)) unbounded();
   if (!(extent_ <= kMaxMagnitude)) {

@@ -202,6 +202,72 @@ TEST(Shapes, SpikeVerticesAreTheRowsOwn) {
   expect_invalid([&] { PaddedPolygon(C, Eigen::Vector3d(1e-3, 1e-3, 1.0), 0.0); }, "polygon.C");
 }
 
+// Every reported vertex satisfies every row given, to 1e-12 of the polygon's size, and the
+// vertices turn counterclockwise (convex).
+void expect_rows_hold_and_convex(const Eigen::MatrixX2d& C, const Eigen::VectorXd& d,
+                                 const PaddedPolygon& polygon) {
+  const Eigen::MatrixX2d& v = polygon.vertices();
+  for (Eigen::Index i = 0; i < v.rows(); ++i) {
+    for (Eigen::Index j = 0; j < C.rows(); ++j) {
+      EXPECT_LE(C.row(j).dot(v.row(i)) - d(j), 1e-12 * polygon.extent() * C.row(j).norm())
+          << "vertex " << i << " row " << j;
+    }
+    const Eigen::Vector2d e = v.row((i + 1) % v.rows()) - v.row(i);
+    const Eigen::Vector2d f = v.row((i + 2) % v.rows()) - v.row((i + 1) % v.rows());
+    EXPECT_GE(e.x() * f.y() - e.y() * f.x(), -1e-12 * polygon.extent() * polygon.extent())
+        << "turn at vertex " << (i + 1) % v.rows();
+  }
+}
+
+// A hostile review's rows: the reduction's predicates had rounded unit normals decide nearly
+// parallel and nearly opposite rows by noise, and its tolerance grew with a loose row's offset.
+TEST(Shapes, ReductionIsExactForNearlyParallelAndOppositeRowsAndLooseRows) {
+  // A unit square with its corner cut by x + y <= 1.5, and a loose row 1e13 away: the cut stays
+  // (it was dropped as cutting less than 1e-12 of 1e13, and the square lost two edges).
+  Eigen::MatrixX2d C(6, 2);
+  C << 1, 0, 0, 1, -1, 0, 0, -1, 1, 1, -1, 1;
+  for (const double far : {1e5, 1e13, 1e100}) {
+    Eigen::VectorXd d(6);
+    d << 1, 1, 1, 1, 1.5, far;
+    const PaddedPolygon cut(C, d, 0.0);
+    EXPECT_EQ(cut.vertices().rows(), 5) << far;
+    EXPECT_NEAR(cut.extent(), std::sqrt(2.0), 1e-15);  // the corners (-1, -1)
+    expect_rows_hold_and_convex(C, d, cut);
+  }
+  // Three rows within 1e-15 rad of parallel: their vertices are within 1e-12 of the polygon's
+  // size of each other (one edge, or two); kept by noise, they put vertices 1,000 away.
+  Eigen::MatrixX2d parallel(5, 2);
+  parallel << 0.8786979172108029, 0.47737822561297977, 0.8786979172108019, 0.47737822561298154,
+      0.8786979172107978, 0.477378225612989, -0.9914774287262685, 0.1302785796911641,
+      0.7255462614896907, -0.6881733956193987;
+  Eigen::VectorXd ones(5);
+  ones << 1.0, 1.0000000000035913, 1.0, 1.0, 1.0;
+  const PaddedPolygon fan(parallel, ones, 0.0);
+  EXPECT_LT(fan.extent(), 3.3);
+  expect_rows_hold_and_convex(parallel, ones, fan);
+  // A needle of two nearly opposite rows 2e-20 apart, rotated: bounded (extent 1), it was refused.
+  Eigen::MatrixX2d needle(3, 2);
+  needle << 0.21887368866980983, 0.9757532005625558, -0.21887368866980986, -0.9757532005625559,
+      0.9757532005625558, -0.21887368866980983;
+  const Eigen::Vector3d needle_d(1e-20, 1e-20, 1.0);
+  const PaddedPolygon thin(needle, needle_d, 0.0);
+  EXPECT_NEAR(thin.extent(), 1.0, 1e-12);
+  expect_rows_hold_and_convex(needle, needle_d, thin);
+  // A needle closed near the origin by two nearly opposite rows, with a back row 7.39 away that
+  // does not touch it: it was kept, and the needle stretched to (-6.58, -3.36).
+  Eigen::MatrixX2d closed(4, 2);
+  closed << 0.45496739475297604, -0.8905080963762708, -0.8905080963762708, -0.45496739475297604,
+      -0.008844937136119155, 0.017312203517198813, 0.8905080963762708, 0.45496739475297604;
+  const Eigen::Vector4d closed_d(1.6048525430508307e-201, 7.387829803484657, 7.884468112133519e-204,
+                                 6.90217553219041);
+  const PaddedPolygon spike(closed, closed_d, 0.0);
+  EXPECT_EQ(spike.vertices().rows(), 3);
+  EXPECT_LT(spike.vertices().col(0).minCoeff(), 0.0);
+  EXPECT_GT(spike.vertices().col(0).minCoeff(), -1e-180);  // the apex at the origin's side
+  EXPECT_NEAR(spike.extent(), std::hypot(6.146443, 3.140265), 1e-5);
+  expect_rows_hold_and_convex(closed, closed_d, spike);
+}
+
 TEST(Shapes, PolygonRejectsBadRows) {
   expect_invalid([] { PaddedPolygon(Eigen::MatrixX2d(2, 2), Eigen::Vector2d(1, 1), 0.1); },
                  "polygon.C");  // fewer than 3 rows
