@@ -17,7 +17,10 @@
 // every row that cuts anything (E > 0), which gives the polygon exactly up to the rounding of its
 // vertices and so its size; then dropping the rows that cut less than 1e-12 of that size off
 // (exact and rounded duplicates, rows through a vertex), and keeping the rows of a 10^5-gon
-// (whose neighbours cut ~2e-9 of its size). A loose row far away (offset 1e13 beside a unit
+// (whose neighbours cut ~2e-9 of its size). What b cuts off is the triangle of the vertices
+// v_ab, v_ac, v_bc, measured by v_ac's distance from the edge v_ab v_bc (not from b's line: for b
+// nearly parallel to a side of a needle, the tip beyond b's line by 1e-15 can be 4.5e-5 from the
+// rest). Drops add up: a vertex may end a few 1e-12 of the size beyond a dropped row. A loose row far away (offset 1e13 beside a unit
 // square) sets nothing: the tolerance is the polygon's size, not the largest offset's.
 //
 // Bounded <=> consecutive kept normals turn by less than pi. The vertices are computed from the
