@@ -4,7 +4,8 @@
 //   hexagon-hexagon  padded regular hexagons, d = 0.6 and 0.43
 // FCL gets the same cores (its capsule axis is body z, ours x; a hexagon is an FCL Convex with one
 // face) and computes a bare distance; diffpills computes phi, both closest points, the normal and
-// the 14-entry gradient, and for *_Jacobian both 6x14 Jacobians too.
+// the 14-entry gradient, and for *_Jacobian both 6x14 Jacobians too, for *_Hessian also the 14x14
+// Hessian of phi.
 #include <benchmark/benchmark.h>
 #include <fcl/geometry/shape/capsule.h>
 #include <fcl/geometry/shape/convex.h>
@@ -78,6 +79,18 @@ void run_jacobian(benchmark::State& state, const A& a, const B& b) {
   int i = 0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(proximity_jacobian(a, s.a[i], b, s.b[i]));
+    i = (i + 1) % kPoses;
+  }
+}
+
+// proximity_hessian: the Jacobians and the 14x14 Hessian of phi (its shapes as Shape).
+template <class A, class B>
+void run_hessian(benchmark::State& state, const A& a, const B& b) {
+  const Scene& s = scene();
+  const Shape shape_a = a, shape_b = b;
+  int i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(proximity_hessian(shape_a, s.a[i], shape_b, s.b[i]));
     i = (i + 1) % kPoses;
   }
 }
@@ -171,6 +184,7 @@ void HexagonHexagon_InteriorPoint(benchmark::State& s) {
   run_proximity(s, kHexagonA, kHexagonB, Method::kInteriorPoint);
 }
 void CapsuleCapsule_Jacobian(benchmark::State& s) { run_jacobian(s, kCapsuleA, kCapsuleB); }
+void CapsuleCapsule_Hessian(benchmark::State& s) { run_hessian(s, kCapsuleA, kCapsuleB); }
 void CapsuleCapsule_FclDistance(benchmark::State& s) {
   const fcl::Capsuled a(0.2, 1.2), b(0.15, 0.8);
   run_fcl(s, a, true, b, true);
@@ -179,6 +193,7 @@ void CapsuleHexagon_Proximity(benchmark::State& s) {
   run_proximity(s, kCapsuleA, kHexagonA, Method::kDefault);
 }
 void CapsuleHexagon_Jacobian(benchmark::State& s) { run_jacobian(s, kCapsuleA, kHexagonA); }
+void CapsuleHexagon_Hessian(benchmark::State& s) { run_hessian(s, kCapsuleA, kHexagonA); }
 void CapsuleHexagon_FclDistance(benchmark::State& s) {
   const fcl::Capsuled a(0.2, 1.2);
   run_fcl(s, a, true, *fcl_hexagon(kHexagonA), false);
@@ -187,6 +202,7 @@ void HexagonHexagon_Proximity(benchmark::State& s) {
   run_proximity(s, kHexagonA, kHexagonB, Method::kDefault);
 }
 void HexagonHexagon_Jacobian(benchmark::State& s) { run_jacobian(s, kHexagonA, kHexagonB); }
+void HexagonHexagon_Hessian(benchmark::State& s) { run_hessian(s, kHexagonA, kHexagonB); }
 void HexagonHexagon_FclDistance(benchmark::State& s) {
   run_fcl(s, *fcl_hexagon(kHexagonA), false, *fcl_hexagon(kHexagonB), false);
 }
@@ -431,14 +447,17 @@ BENCHMARK(CapsuleCapsule_FclDistance);
 BENCHMARK(CapsuleCapsule_Proximity);
 BENCHMARK(CapsuleCapsule_InteriorPoint);
 BENCHMARK(CapsuleCapsule_Jacobian);
+BENCHMARK(CapsuleCapsule_Hessian);
 BENCHMARK(CapsuleHexagon_FclDistance);
 BENCHMARK(CapsuleHexagon_Proximity);
 BENCHMARK(CapsuleHexagon_InteriorPoint);
 BENCHMARK(CapsuleHexagon_Jacobian);
+BENCHMARK(CapsuleHexagon_Hessian);
 BENCHMARK(HexagonHexagon_FclDistance);
 BENCHMARK(HexagonHexagon_Proximity);
 BENCHMARK(HexagonHexagon_InteriorPoint);
 BENCHMARK(HexagonHexagon_Jacobian);
+BENCHMARK(HexagonHexagon_Hessian);
 BENCHMARK(CapsuleCapsule_FclSignedDistance);
 BENCHMARK(CapsuleCapsule_SignedDistance);
 BENCHMARK(CapsuleHexagon_FclSignedDistance);

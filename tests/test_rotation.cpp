@@ -70,6 +70,45 @@ TEST(Rotation, JacobiansMatchCentralDifferences) {
   }
 }
 
+// The Hessian of w . Q(q / |q|) v: central differences of its gradient (computed with Eigen's
+// quaternion here, not rotate_gradient), symmetric, and with q itself in its null space's
+// complement (G is of degree 0: hess q = -grad, by Euler's theorem for the gradient).
+TEST(Rotation, HessianMatchesCentralDifferencesOfTheGradient) {
+  Rng rng(5);
+  for (int i = 0; i < 1000; ++i) {
+    const Eigen::Vector4d q = random_quaternion(rng);
+    const Eigen::Vector3d v = random_vector(rng), w = random_vector(rng);
+    const auto value = [&](const Eigen::Vector4d& p) {
+      const Eigen::Quaterniond eigen(p(0), p(1), p(2), p(3));
+      return w.dot(eigen.normalized() * v);
+    };
+    const auto gradient = [&](const Eigen::Vector4d& p) {
+      Eigen::Vector4d out;
+      for (int j = 0; j < 4; ++j) {
+        const double step = 1e-5;
+        Eigen::Vector4d plus = p, minus = p;
+        plus(j) += step;
+        minus(j) -= step;
+        out(j) = (value(plus) - value(minus)) / (2 * step);
+      }
+      return out;
+    };
+    const Eigen::Matrix4d H = rotate_hessian(q, v, w);
+    Eigen::Matrix4d numeric;
+    for (int j = 0; j < 4; ++j) {
+      const double step = 1e-4;
+      Eigen::Vector4d plus = q, minus = q;
+      plus(j) += step;
+      minus(j) -= step;
+      numeric.col(j) = (gradient(plus) - gradient(minus)) / (2 * step);
+    }
+    const double size = v.norm() * w.norm() / q.squaredNorm();
+    EXPECT_LE((H - numeric).cwiseAbs().maxCoeff(), 1e-5 * (1 + size)) << i;
+    EXPECT_LE((H - H.transpose()).cwiseAbs().maxCoeff(), 1e-13 * size);
+    EXPECT_LE((H * q + rotate_gradient(q, v, w)).norm(), 1e-12 * (1 + size * q.norm()));
+  }
+}
+
 TEST(Rotation, LeftAndRightMultiplyAndAttitudeJacobian) {
   Rng rng(3);
   for (int i = 0; i < 500; ++i) {

@@ -110,6 +110,15 @@ struct ProximityJacobian : Proximity {
       Eigen::Matrix<double, 6, 14>::Zero();  // d[p~1; p~2]
 };
 
+// The 14 x 14 Hessian of phi with respect to [r1 q1 r2 q2] (quaternion normalization included),
+// symmetric. Exact where phi is twice differentiable (unique closest points, strict
+// complementarity); elsewhere the derivative of the reported gradient along the closest points'
+// reported Jacobians (one of the one-sided choices); 0 where the cores intersect (phi is flat
+// there). Derivation in src/proximity/proximity_hessian.cpp.
+struct ProximityHessian : ProximityJacobian {
+  Eigen::Matrix<double, 14, 14> hessian = Eigen::Matrix<double, 14, 14>::Zero();
+};
+
 // Thrown when the QP solver does not converge (never silently wrong).
 class SolverError : public std::runtime_error {
  public:
@@ -138,5 +147,8 @@ ProximityJacobian proximity_jacobian(const PaddedPolygon& a, const Pose& pose_a,
                                      const ProximityOptions& options = {});
 ProximityJacobian proximity_jacobian(const Shape& a, const Pose& pose_a, const Shape& b,
                                      const Pose& pose_b, const ProximityOptions& options = {});
+
+ProximityHessian proximity_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
+                                   const Pose& pose_b, const ProximityOptions& options = {});
 
 }  // namespace diffpills

@@ -22,6 +22,11 @@ Eigen::Matrix<double, 3, 4> rotate_jacobian(const Eigen::Vector4d& q, const Eige
 Eigen::Vector4d rotate_gradient(const Eigen::Vector4d& q, const Eigen::Vector3d& v,
                                 const Eigen::Vector3d& w);
 
+// d^2/dq^2 [ w . Q(q / |q|) v ]  (4x4, symmetric): the second derivative of rotate_gradient's
+// function, normalization included (for Hessians of phi and of the signed distance).
+Eigen::Matrix4d rotate_hessian(const Eigen::Vector4d& q, const Eigen::Vector3d& v,
+                               const Eigen::Vector3d& w);
+
 // d/dq [ Q(q / |q|)^T v ]  (3x4), for a fixed world-frame vector v.
 Eigen::Matrix<double, 3, 4> rotate_transpose_jacobian(const Eigen::Vector4d& q,
                                                       const Eigen::Vector3d& v);

@@ -1,0 +1,152 @@
+// The Hessian of phi (proximity_hessian) against central differences of proximity()'s exact
+// gradient, on 1,000 random pairs per ordering (apart; kinks, where the closest features change
+// within the step, are detected by two step sizes and counted); exact scaling by powers of two;
+// swapping the shapes; zero where the cores intersect.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "diffpills/diffpills.hpp"
+#include "support/random_shapes.hpp"
+
+namespace diffpills::testing {
+namespace {
+
+using Vector14 = Eigen::Matrix<double, 14, 1>;
+using Matrix14 = Eigen::Matrix<double, 14, 14>;
+
+Vector14 gradient_at(const Shape& a, const Shape& b, const Vector14& x) {
+  return proximity(a, Pose(x.segment<3>(0), x.segment<4>(3)), b,
+                   Pose(x.segment<3>(7), x.segment<4>(10)))
+      .gradient;
+}
+
+// Central differences of the gradient at steps h and h / 4; false where a column disagrees (a
+// kink within the step).
+bool differences(const Shape& a, const Shape& b, const Vector14& x, double h, Matrix14& out) {
+  for (int j = 0; j < 14; ++j) {
+    const auto column = [&](double step) {
+      Vector14 plus = x, minus = x;
+      plus(j) += step;
+      minus(j) -= step;
+      return Vector14((gradient_at(a, b, plus) - gradient_at(a, b, minus)) / (2 * step));
+    };
+    const Vector14 coarse = column(h), fine = column(h / 4);
+    if ((coarse - fine).cwiseAbs().maxCoeff() > 1e-5 * (1.0 + fine.cwiseAbs().maxCoeff())) {
+      return false;
+    }
+    out.col(j) = fine;
+  }
+  return true;
+}
+
+TestShape random_shape(Rng& rng, bool capsule) {
+  return capsule ? random_capsule(rng, 1.0, 0.05) : random_polygon(rng, 1.0);
+}
+
+TEST(Hessian, MatchesCentralDifferencesOfTheGradient) {
+  Rng rng(31);
+  for (const bool capsule_a : {true, false}) {
+    for (const bool capsule_b : {true, false}) {
+      int checked = 0, kinks = 0, intersecting = 0;
+      double worst = 0.0;
+      for (int trial = 0; trial < 1000; ++trial) {
+        const TestShape ta = random_shape(rng, capsule_a), tb = random_shape(rng, capsule_b);
+        const Pose pa = random_pose(rng, 1.5), pb = random_pose(rng, 1.5);
+        const ProximityHessian exact = proximity_hessian(ta.shape, pa, tb.shape, pb);
+        if (exact.cores_intersect) {
+          EXPECT_EQ(exact.hessian, Matrix14::Zero());
+          ++intersecting;
+          continue;
+        }
+        Vector14 x;
+        x << pa.r(), pa.q(), pb.r(), pb.q();
+        Matrix14 numeric;
+        if (!differences(ta.shape, tb.shape, x, 1e-5, numeric)) {
+          ++kinks;
+          continue;
+        }
+        const double error =
+            (exact.hessian - numeric).cwiseAbs().maxCoeff() / (1.0 + numeric.cwiseAbs().maxCoeff());
+        worst = std::max(worst, error);
+        EXPECT_LE(error, 1e-5) << "capsules " << capsule_a << capsule_b << " trial " << trial
+                               << "\nexact\n"
+                               << exact.hessian << "\nnumeric\n"
+                               << numeric;
+        ++checked;
+      }
+      EXPECT_GE(checked, 700) << "too few smooth cases: the check would prove little";
+      std::printf("capsules %d%d: %d checked, %d at kinks, %d intersecting, worst %.2g\n",
+                  capsule_a, capsule_b, checked, kinks, intersecting, worst);
+    }
+  }
+}
+
+// Scaling every length by 2^k: phi scales by 2^2k, so d2phi/dr2 is unchanged, d2phi/drdq scales
+// by 2^k and d2phi/dq2 by 2^2k, exactly (the query is solved in a frame scaled by a power of two).
+TEST(Hessian, ScalesExactlyWithPowersOfTwo) {
+  Rng rng(32);
+  for (int trial = 0; trial < 100; ++trial) {
+    const bool capsule_a = trial % 2 == 0, capsule_b = trial % 3 == 0;
+    const TestShape ta = random_shape(rng, capsule_a), tb = random_shape(rng, capsule_b);
+    const Pose pa = random_pose(rng, 1.5), pb = random_pose(rng, 1.5);
+    for (const int k : {-30, 12}) {
+      const double s = std::ldexp(1.0, k);
+      const auto scaled = [&](const Shape& shape) -> Shape {
+        if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+          return Capsule(s * capsule->length(), s * capsule->radius());
+        }
+        const auto& polygon = std::get<PaddedPolygon>(shape);
+        return PaddedPolygon(polygon.constraint_matrix(), s * polygon.constraint_offsets(),
+                             s * polygon.radius());
+      };
+      const Matrix14 base = proximity_hessian(ta.shape, pa, tb.shape, pb).hessian;
+      const Matrix14 big = proximity_hessian(scaled(ta.shape), Pose(s * pa.r(), pa.q()),
+                                             scaled(tb.shape), Pose(s * pb.r(), pb.q()))
+                               .hessian;
+      for (int i = 0; i < 14; ++i) {
+        for (int j = 0; j < 14; ++j) {
+          const int power = (i % 7 >= 3) + (j % 7 >= 3);  // q rows and columns carry a length
+          EXPECT_EQ(big(i, j), std::ldexp(base(i, j), k * power))
+              << "trial " << trial << " k " << k << " (" << i << ", " << j << ")";
+        }
+      }
+    }
+  }
+}
+
+// Swapping the shapes permutes the Hessian's blocks.
+TEST(Hessian, SwappingTheShapesPermutesTheBlocks) {
+  Rng rng(33);
+  for (int trial = 0; trial < 200; ++trial) {
+    const TestShape ta = random_shape(rng, trial % 2 == 0), tb = random_shape(rng, trial % 3 == 0);
+    const Pose pa = random_pose(rng, 1.5), pb = random_pose(rng, 1.5);
+    const Matrix14 forward = proximity_hessian(ta.shape, pa, tb.shape, pb).hessian;
+    const Matrix14 backward = proximity_hessian(tb.shape, pb, ta.shape, pa).hessian;
+    Eigen::PermutationMatrix<14> swap;
+    for (int i = 0; i < 14; ++i) swap.indices()(i) = (i + 7) % 14;
+    const Matrix14 permuted = swap.transpose() * backward * swap;
+    EXPECT_LE((forward - permuted).cwiseAbs().maxCoeff(),
+              1e-9 * (1.0 + forward.cwiseAbs().maxCoeff()))
+        << "trial " << trial;
+  }
+}
+
+// An analytic case: two points (capsules of length 0) at distance vector e = r1 - r2: phi =
+// |e|^2 - R^2, whose Hessian in (r1, r2) is 2 [I -I; -I I] and 0 in the quaternions.
+TEST(Hessian, TwoSpheres) {
+  const Capsule sphere(0.0, 0.1);
+  const ProximityHessian h =
+      proximity_hessian(sphere, Pose({0.3, -0.2, 1.0}, {0.9, 0.1, 0.3, -0.2}), sphere,
+                        Pose({-1.0, 0.5, 0.2}, {1, 0, 0, 0}));
+  Matrix14 expected = Matrix14::Zero();
+  for (int i = 0; i < 3; ++i) {
+    expected(i, i) = expected(7 + i, 7 + i) = 2.0;
+    expected(i, 7 + i) = expected(7 + i, i) = -2.0;
+  }
+  EXPECT_LE((h.hessian - expected).cwiseAbs().maxCoeff(), 1e-14);
+}
+
+}  // namespace
+}  // namespace diffpills::testing
