@@ -273,6 +273,8 @@ Output to_json(const SignedDistanceJacobian& result) {
   return out;
 }
 
+Output matrix_rows(const Eigen::MatrixXd& matrix) { return rows(matrix); }
+
 Output to_json(const std::array<ShapeGradient, 2>& shape_gradient) {
   const auto one = [](const ShapeGradient& gradient) -> Output {
     if (const auto* capsule = std::get_if<CapsuleShapeGradient>(&gradient)) {

@@ -40,6 +40,8 @@ nlohmann::ordered_json to_json(const ProximityJacobian& result);
 // that of the core points.
 nlohmann::ordered_json to_json(const SignedDistance& result);
 nlohmann::ordered_json to_json(const SignedDistanceJacobian& result);
+// A matrix as JSON rows ("hessian": [14 rows of 14]).
+nlohmann::ordered_json matrix_rows(const Eigen::MatrixXd& matrix);
 // DESIGN.md section 3b: {"a": S, "b": S}, S = {"length", "radius"} for a capsule, {"C": [m rows of
 // 2], "d": [m], "radius"} for a polygon.
 nlohmann::ordered_json to_json(const std::array<ShapeGradient, 2>& shape_gradient);

@@ -31,7 +31,7 @@ A query:
          "radius": 0.1, "r": [0,0,1], "q": [1,0,0,0]},
    "jacobian": true}
   Optional: "jacobian" (false by default), "method": "default" | "interior_point",
-  "signed_distance" and "shape_gradient" (false by default).
+  "signed_distance", "shape_gradient" and "hessian" (false by default).
   Quaternions are [w, x, y, z]; a capsule's core lies along its body x axis; a polygon is
   {y : C y <= d} in its body x-y plane with d > 0.
 
@@ -42,9 +42,11 @@ An answer:
    "signed_distance": {"distance": ..., "points": [x~1, x~2], "normal": [...],
      "gradient": [14 numbers: d distance/d(r1, q1, r2, q2)], "core_points": [x1, x2],
      "penetrating": false, "jacobian": 6x14 rows of the points,
-     "core_points_jacobian": 6x14 rows, "shape_gradient": {...}},
+     "core_points_jacobian": 6x14 rows, "hessian": ..., "shape_gradient": {...}},
                                            (signed_distance only if asked, its Jacobians
                                             only with "jacobian")
+   "hessian": 14 rows of 14,             (only if asked; of phi, and of the distance inside
+                                           signed_distance when both are asked)
    "shape_gradient": {"a": S, "b": S}}   (only if asked; of phi, and of the distance inside
                                            signed_distance: S = {"length", "radius"} for a
                                            capsule, {"C": m rows of 2, "d": [m], "radius"} for

@@ -26,7 +26,7 @@ nlohmann::ordered_json answer(const json& query) {
     throw std::invalid_argument("query: must be " + kQueryLine);
   }
   static const std::set<std::string> allowed = {
-      "a", "b", "jacobian", "method", "shape_gradient", "signed_distance"};
+      "a", "b", "hessian", "jacobian", "method", "shape_gradient", "signed_distance"};
   for (const auto& item : query.items()) {
     if (allowed.count(item.key()) == 0) {
       throw std::invalid_argument(item.key() + ": unknown field");
@@ -40,6 +40,7 @@ nlohmann::ordered_json answer(const json& query) {
   const bool jacobian = flag(query, "jacobian");
   const bool signed_distance = flag(query, "signed_distance");
   const bool shape_gradient = flag(query, "shape_gradient");
+  const bool hessian = flag(query, "hessian");
   ProximityOptions options;
   if (query.contains("method")) {
     const json& method = query["method"];
@@ -54,6 +55,10 @@ nlohmann::ordered_json answer(const json& query) {
   nlohmann::ordered_json out =
       jacobian ? to_json(proximity_jacobian(a.shape, a.pose, b.shape, b.pose, options))
                : to_json(proximity(a.shape, a.pose, b.shape, b.pose, options));
+  if (hessian) {
+    out["hessian"] =
+        matrix_rows(proximity_hessian(a.shape, a.pose, b.shape, b.pose, options).hessian);
+  }
   if (shape_gradient) {
     out["shape_gradient"] =
         to_json(proximity_shape_gradient(a.shape, a.pose, b.shape, b.pose, options).shape_gradient);
@@ -62,6 +67,10 @@ nlohmann::ordered_json answer(const json& query) {
     out["signed_distance"] =
         jacobian ? to_json(signed_distance_jacobian(a.shape, a.pose, b.shape, b.pose))
                  : to_json(diffpills::signed_distance(a.shape, a.pose, b.shape, b.pose));
+    if (hessian) {
+      out["signed_distance"]["hessian"] =
+          matrix_rows(signed_distance_hessian(a.shape, a.pose, b.shape, b.pose).hessian);
+    }
     if (shape_gradient) {
       out["signed_distance"]["shape_gradient"] =
           to_json(signed_distance_shape_gradient(a.shape, a.pose, b.shape, b.pose).shape_gradient);

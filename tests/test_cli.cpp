@@ -158,6 +158,31 @@ TEST(Cli, ShapeGradientMatchesTheLibrary) {
   expect_error(query_with(kCapsule, kPolygon, R"(, "shape_gradient": "yes")"), "shape_gradient");
 }
 
+// "hessian": true adds the 14x14 Hessian of phi, and of the distance inside "signed_distance"
+// when both are asked (DESIGN.md section 3b), as the library gives them.
+TEST(Cli, HessianMatchesTheLibrary) {
+  const json out =
+      answer(query_with(kCapsule, kPolygon, R"(, "hessian": true, "signed_distance": true)"));
+  Eigen::MatrixX2d C(4, 2);
+  C << 1, 0, 0, 1, -1, 0, 0, -1;
+  const Shape capsule = Capsule(2.0, 0.2);
+  const Shape polygon = PaddedPolygon(C, Eigen::Vector4d(1, 1, 1, 1), 0.1);
+  const Pose polygon_pose({0.3, 0.1, 1}, {0.9, 0.1, 0.2, 0});
+  const auto phi = proximity_hessian(capsule, Pose(), polygon, polygon_pose).hessian;
+  const auto distance = signed_distance_hessian(capsule, Pose(), polygon, polygon_pose).hessian;
+  ASSERT_EQ(out["hessian"].size(), 14u);
+  ASSERT_EQ(out["signed_distance"]["hessian"].size(), 14u);
+  for (int i = 0; i < 14; ++i) {
+    ASSERT_EQ(out["hessian"][i].size(), 14u);
+    for (int j = 0; j < 14; ++j) {
+      EXPECT_EQ(out["hessian"][i][j].get<double>(), phi(i, j));
+      EXPECT_EQ(out["signed_distance"]["hessian"][i][j].get<double>(), distance(i, j));
+    }
+  }
+  EXPECT_FALSE(answer(query_with(kCapsule, kPolygon)).contains("hessian"));
+  expect_error(query_with(kCapsule, kPolygon, R"(, "hessian": null)"), "hessian");
+}
+
 TEST(Cli, BadInputGetsAnErrorNamingTheField) {
   expect_error("{\"a\": ", "a: malformed JSON");  // the value of "a" is missing
   expect_error("[1, 2]", "query");

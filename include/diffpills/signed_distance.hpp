@@ -16,11 +16,11 @@
 //
 // Points, normal. normal is unit, from shape 1 to shape 2: (p2 - p1) / |p2 - p1| apart, the
 // outward normal of D's nearest facet in penetration; from the features (a face's normal, e x f
-// of two edges) wherever they fix it, so that it is exact also near touching (proximity.hpp). core_points = {x1, x2} on the cores with
-// x2 - x1 = s * normal (apart: the closest points; in penetration: the deepest points of the two
-// cores along the normal), points = {x1 + R1 normal, x2 - R2 normal} on the surfaces, so that
-// points[1] - points[0] = distance * normal. Where those points are not unique, the middle of the
-// set, as for proximity().
+// of two edges) wherever they fix it, so that it is exact also near touching (proximity.hpp).
+// core_points = {x1, x2} on the cores with x2 - x1 = s * normal (apart: the closest points; in
+// penetration: the deepest points of the two cores along the normal), points = {x1 + R1 normal, x2
+// - R2 normal} on the surfaces, so that points[1] - points[0] = distance * normal. Where those
+// points are not unique, the middle of the set, as for proximity().
 //
 // Derivatives. Apart, s is the optimal value of the closest-point problem; in penetration, of
 // min over unit n of h_1(n) + h_2(-n) (support functions), whose feasible set does not depend on
@@ -81,6 +81,18 @@ struct SignedDistanceJacobian : SignedDistance {
       Eigen::Matrix<double, 6, 14>::Zero();  // d[points[0]; points[1]]
 };
 
+// The 14 x 14 Hessian of the distance with respect to [r1 q1 r2 q2] (quaternion normalization
+// included), symmetric: exact where the distance is twice differentiable (unique witness points
+// and nearest facet), elsewhere the derivative of the reported gradient along the reported
+// Jacobians (one of the one-sided choices; for a flat D with its fixed normal, the normal's
+// motion is 0). From the witness points' and the normal's Jacobians (src/proximity/
+// measure_hessian.hpp with w = -normal).
+struct SignedDistanceHessian : SignedDistanceJacobian {
+  Eigen::Matrix<double, 3, 14> normal_jacobian =
+      Eigen::Matrix<double, 3, 14>::Zero();  // d normal / d[r1 q1 r2 q2]
+  Eigen::Matrix<double, 14, 14> hessian = Eigen::Matrix<double, 14, 14>::Zero();
+};
+
 SignedDistance signed_distance(const Capsule& a, const Pose& pose_a, const Capsule& b,
                                const Pose& pose_b);
 SignedDistance signed_distance(const Capsule& a, const Pose& pose_a, const PaddedPolygon& b,
@@ -102,5 +114,8 @@ SignedDistanceJacobian signed_distance_jacobian(const PaddedPolygon& a, const Po
                                                 const PaddedPolygon& b, const Pose& pose_b);
 SignedDistanceJacobian signed_distance_jacobian(const Shape& a, const Pose& pose_a, const Shape& b,
                                                 const Pose& pose_b);
+
+SignedDistanceHessian signed_distance_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
+                                              const Pose& pose_b);
 
 }  // namespace diffpills

@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "core_outline.hpp"
+#include "measure_hessian.hpp"
 #include "pair_frame.hpp"
 #include "pair_setup.hpp"
 #include "penetration.hpp"
@@ -136,7 +137,15 @@ Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& p
   const PosedCore posed_a = detail::posed_core(a, pose_a, pose_a.r(), frame);
   const PosedCore posed_b = detail::posed_core(b, pose_b, pose_a.r(), frame);
   const SignedSolution solution = solve(a, posed_a, b, posed_b, frame);
-  if constexpr (std::is_same_v<Result, SignedDistanceJacobian>) {
+  if constexpr (std::is_same_v<Result, SignedDistanceHessian>) {
+    // measure_hessian.hpp with w = -normal (the distance's gradient is d(P_1 - P_2)/dx' w).
+    SignedDistanceHessian out;
+    static_cast<SignedDistanceJacobian&>(out) = detail::make_signed_distance_jacobian(
+        frame, pose_a, posed_a, pose_b, posed_b, solution, &out.normal_jacobian);
+    out.hessian = detail::measure_hessian(pose_a, pose_b, out.core_points, out.core_points_jacobian,
+                                          -out.normal, -out.normal_jacobian);
+    return out;
+  } else if constexpr (std::is_same_v<Result, SignedDistanceJacobian>) {
     return detail::make_signed_distance_jacobian(frame, pose_a, posed_a, pose_b, posed_b, solution);
   } else {
     return detail::make_signed_distance(frame, pose_a, posed_a, pose_b, posed_b, solution);
@@ -191,6 +200,15 @@ SignedDistanceJacobian signed_distance_jacobian(const Shape& a, const Pose& pose
   return std::visit(
       [&](const auto& shape_a, const auto& shape_b) {
         return query<SignedDistanceJacobian>(shape_a, pose_a, shape_b, pose_b);
+      },
+      a, b);
+}
+
+SignedDistanceHessian signed_distance_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
+                                              const Pose& pose_b) {
+  return std::visit(
+      [&](const auto& shape_a, const auto& shape_b) {
+        return query<SignedDistanceHessian>(shape_a, pose_a, shape_b, pose_b);
       },
       a, b);
 }

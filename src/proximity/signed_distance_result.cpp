@@ -30,10 +30,10 @@ SignedDistance make_signed_distance(const PairFrame& frame, const Pose& pose_a, 
   return result;
 }
 
-SignedDistanceJacobian make_signed_distance_jacobian(const PairFrame& frame, const Pose& pose_a,
-                                                     const PosedCore& a, const Pose& pose_b,
-                                                     const PosedCore& b,
-                                                     const SignedSolution& solution) {
+SignedDistanceJacobian make_signed_distance_jacobian(
+    const PairFrame& frame, const Pose& pose_a, const PosedCore& a, const Pose& pose_b,
+    const PosedCore& b, const SignedSolution& solution,
+    Eigen::Matrix<double, 3, 14>* normal_jacobian) {
   SignedDistanceJacobian result;
   static_cast<SignedDistance&>(result) =
       make_signed_distance(frame, pose_a, a, pose_b, b, solution);
@@ -45,6 +45,12 @@ SignedDistanceJacobian make_signed_distance_jacobian(const PairFrame& frame, con
   const Matrix3x14 dnormal = source_normal_motion(solution.source, a, b, x2 - x1, motion);
   point_jacobians(frame.scale, a, b, motion, dnormal, result.core_points_jacobian,
                   result.points_jacobian);
+  if (normal_jacobian != nullptr) {
+    // The frame's lengths are the inputs' over the scale: d/dr gains 1 / scale; the normal and
+    // the quaternions are unitless.
+    *normal_jacobian = dnormal;
+    for (const int column : {0, 7}) normal_jacobian->middleCols<3>(column) /= frame.scale;
+  }
   return result;
 }
 

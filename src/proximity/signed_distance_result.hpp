@@ -27,9 +27,10 @@ struct SignedSolution {
 SignedDistance make_signed_distance(const PairFrame& frame, const Pose& pose_a, const PosedCore& a,
                                     const Pose& pose_b, const PosedCore& b,
                                     const SignedSolution& solution);
-SignedDistanceJacobian make_signed_distance_jacobian(const PairFrame& frame, const Pose& pose_a,
-                                                     const PosedCore& a, const Pose& pose_b,
-                                                     const PosedCore& b,
-                                                     const SignedSolution& solution);
+// With normal_jacobian, also d normal / d[r1 q1 r2 q2] in the inputs' units.
+SignedDistanceJacobian make_signed_distance_jacobian(
+    const PairFrame& frame, const Pose& pose_a, const PosedCore& a, const Pose& pose_b,
+    const PosedCore& b, const SignedSolution& solution,
+    Eigen::Matrix<double, 3, 14>* normal_jacobian = nullptr);
 
 }  // namespace diffpills::detail
