@@ -12,6 +12,8 @@ Shapes: ``Capsule(length, radius)`` and ``PaddedPolygon(C, d, radius)``, each po
 ``signed_distance(a, pose_a, b, pose_b)``, ``signed_distance_jacobian``, ``signed_distance_batch``
     the signed distance (the gap, or minus the penetration depth) with its exact gradient, which
     keeps a slope where phi is flat (overlapping cores).
+``proximity_hessian(a, pose_a, b, pose_b)``, ``signed_distance_hessian``
+    the same plus the (14, 14) Hessian with respect to both poses.
 ``proximity_shape_gradient(a, pose_a, b, pose_b)``, ``signed_distance_shape_gradient``
     the same plus ``shape_gradient``: the derivatives with respect to each shape's own parameters
     (a capsule's length and radius, a polygon's C, d and radius).
@@ -36,9 +38,11 @@ from ._core import (
     PaddedPolygon,
     Pose,
     Proximity,
+    ProximityHessian,
     ProximityJacobian,
     ProximityShapeGradient,
     SignedDistance,
+    SignedDistanceHessian,
     SignedDistanceJacobian,
     SignedDistanceShapeGradient,
     Scene,
@@ -46,10 +50,12 @@ from ._core import (
     __version__,
     proximity,
     proximity_batch,
+    proximity_hessian,
     proximity_jacobian,
     proximity_shape_gradient,
     signed_distance,
     signed_distance_batch,
+    signed_distance_hessian,
     signed_distance_jacobian,
     signed_distance_shape_gradient,
 )
@@ -61,9 +67,11 @@ __all__ = [
     "PaddedPolygon",
     "Pose",
     "Proximity",
+    "ProximityHessian",
     "ProximityJacobian",
     "ProximityShapeGradient",
     "SignedDistance",
+    "SignedDistanceHessian",
     "SignedDistanceJacobian",
     "SignedDistanceShapeGradient",
     "Scene",
@@ -71,10 +79,12 @@ __all__ = [
     "__version__",
     "proximity",
     "proximity_batch",
+    "proximity_hessian",
     "proximity_jacobian",
     "proximity_shape_gradient",
     "signed_distance",
     "signed_distance_batch",
+    "signed_distance_hessian",
     "signed_distance_jacobian",
     "signed_distance_shape_gradient",
 ]
@@ -100,10 +110,12 @@ for _class in (
     PaddedPolygon,
     Pose,
     Proximity,
+    ProximityHessian,
     ProximityJacobian,
     ProximityShapeGradient,
     Scene,
     SignedDistance,
+    SignedDistanceHessian,
     SignedDistanceJacobian,
     SignedDistanceShapeGradient,
 ):

@@ -83,6 +83,12 @@ template <>
 class type_caster<diffpills::SignedDistanceJacobian>
     : public diffpills::python::ConstructedCaster<diffpills::SignedDistanceJacobian> {};
 template <>
+class type_caster<diffpills::ProximityHessian>
+    : public diffpills::python::ConstructedCaster<diffpills::ProximityHessian> {};
+template <>
+class type_caster<diffpills::SignedDistanceHessian>
+    : public diffpills::python::ConstructedCaster<diffpills::SignedDistanceHessian> {};
+template <>
 class type_caster<diffpills::ProximityShapeGradient>
     : public diffpills::python::ConstructedCaster<diffpills::ProximityShapeGradient> {};
 template <>
@@ -680,6 +686,58 @@ void bind_shape_gradient_results(py::module_& m) {
           }));
 }
 
+void bind_hessian_results(py::module_& m) {
+  py::class_<ProximityHessian, ProximityJacobian>(m, "ProximityHessian",
+                                                  R"(The result of diffpills.proximity_hessian:
+everything of ProximityJacobian, plus
+
+hessian  (14, 14): d^2 phi / d[r_a, q_a, r_b, q_b]^2, symmetric (0 where the cores intersect))")
+      .def_readonly("hessian", &ProximityHessian::hessian)
+      .def(py::pickle(
+          [](const ProximityHessian& p) -> py::object {
+            return py::make_tuple(proximity_state(p), p.core_points_jacobian, p.points_jacobian,
+                                  p.hessian);
+          },
+          [](const py::object& state) {
+            const py::tuple fields =
+                pickled_state(state, 4,
+                              std::string("(") + kProximityFields +
+                                  ", core_points_jacobian, points_jacobian, hessian)");
+            ProximityHessian p;
+            restore_proximity(p, fields[0]);
+            p.core_points_jacobian = fixed_matrix<6, 14>(fields[1], "core_points_jacobian");
+            p.points_jacobian = fixed_matrix<6, 14>(fields[2], "points_jacobian");
+            p.hessian = fixed_matrix<14, 14>(fields[3], "hessian");
+            return p;
+          }));
+  py::class_<SignedDistanceHessian, SignedDistanceJacobian>(
+      m, "SignedDistanceHessian", R"(The result of diffpills.signed_distance_hessian: everything
+of SignedDistanceJacobian, plus
+
+normal_jacobian  (3, 14): d normal / d[r_a, q_a, r_b, q_b]
+hessian          (14, 14): d^2 distance / d[r_a, q_a, r_b, q_b]^2, symmetric)")
+      .def_readonly("normal_jacobian", &SignedDistanceHessian::normal_jacobian)
+      .def_readonly("hessian", &SignedDistanceHessian::hessian)
+      .def(py::pickle(
+          [](const SignedDistanceHessian& s) -> py::object {
+            return py::make_tuple(signed_distance_state(s), s.core_points_jacobian,
+                                  s.points_jacobian, s.normal_jacobian, s.hessian);
+          },
+          [](const py::object& state) {
+            const py::tuple fields = pickled_state(
+                state, 5,
+                std::string("(") + kSignedDistanceFields +
+                    ", core_points_jacobian, points_jacobian, normal_jacobian, hessian)");
+            SignedDistanceHessian s;
+            restore_signed_distance(s, fields[0]);
+            s.core_points_jacobian = fixed_matrix<6, 14>(fields[1], "core_points_jacobian");
+            s.points_jacobian = fixed_matrix<6, 14>(fields[2], "points_jacobian");
+            s.normal_jacobian = fixed_matrix<3, 14>(fields[3], "normal_jacobian");
+            s.hessian = fixed_matrix<14, 14>(fields[4], "hessian");
+            return s;
+          }));
+}
+
 void bind_results(py::module_& m) {
   py::class_<Proximity>(m, "Proximity", R"(The result of diffpills.proximity.
 
@@ -737,6 +795,7 @@ points_jacobian       (6, 14): d[surface point a; surface point b] / d[r_a, q_a,
           }));
   bind_signed_distance_results(m);
   bind_shape_gradient_results(m);
+  bind_hessian_results(m);
 }
 
 // A query of two shapes of any type: call(shape_a, pose_a, shape_b, pose_b).
@@ -1236,6 +1295,34 @@ gradient (14,) = d distance / d[r_a, q_a, r_b, q_b].)");
       },
       py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
       R"(As signed_distance, plus core_points_jacobian and points_jacobian (6, 14).)");
+  m.def(
+      "proximity_hessian",
+      [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
+         const py::handle& pose_b, const py::handle& method) {
+        const ProximityOptions options{to_method(method)};
+        return pair_query<ProximityHessian>(
+            a, pose_a, b, pose_b,
+            [&](const auto& x, const Pose& px, const auto& y, const Pose& py_) {
+              return proximity_hessian(Shape(x), px, Shape(y), py_, options);
+            });
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
+      py::arg("method") = "default",
+      R"(As proximity_jacobian, plus hessian (14, 14): the second derivatives of phi with respect
+to [r_a, q_a, r_b, q_b], quaternion normalization included.)");
+  m.def(
+      "signed_distance_hessian",
+      [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
+         const py::handle& pose_b) {
+        return pair_query<SignedDistanceHessian>(
+            a, pose_a, b, pose_b,
+            [](const auto& x, const Pose& px, const auto& y, const Pose& py_) {
+              return signed_distance_hessian(Shape(x), px, Shape(y), py_);
+            });
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
+      R"(As signed_distance_jacobian, plus normal_jacobian (3, 14) and hessian (14, 14): the
+second derivatives of the distance with respect to [r_a, q_a, r_b, q_b].)");
   m.def(
       "proximity_shape_gradient",
       [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
