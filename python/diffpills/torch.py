@@ -65,6 +65,18 @@ def _tensor(name, array, like):
 _POSE_COLUMNS = {"r_a": slice(0, 3), "q_a": slice(3, 7), "r_b": slice(7, 10), "q_b": slice(10, 14)}
 
 
+def _pose_gradients(weighted, shared, like):
+    """The (N, 14) weighted float64 gradients split into r_a, q_a, r_b, q_b's, each summed over
+    the rows where its pose was shared, in ``like``'s dtype and device (checked for overflow)."""
+    out = []
+    for (name, columns), is_shared in zip(_POSE_COLUMNS.items(), shared):
+        part = weighted[:, columns]
+        if is_shared:
+            part = part.sum(0, keepdim=True)
+        out.append(_tensor(f"the gradient of {name}", part.numpy(), like))
+    return out
+
+
 class _Batch(torch.autograd.Function):
     """A value of N pose pairs (phi or the signed distance), with backward through the analytic
     gradient. ``batch`` is the diffpills batch function, called with keyword ``options``; each pose
@@ -90,13 +102,7 @@ class _Batch(torch.autograd.Function):
         _refuse_second_derivatives()
         (gradient,) = ctx.saved_tensors
         weighted = gradient * grad_value.detach().to(device="cpu", dtype=torch.float64).unsqueeze(1)
-        grads = []
-        for (name, columns), shared in zip(_POSE_COLUMNS.items(), ctx.shared):
-            part = weighted[:, columns]
-            if shared:
-                part = part.sum(0, keepdim=True)
-            grads.append(_tensor(f"the gradient of {name}", part.numpy(), ctx.like))
-        return (None, None, None, None, None, *grads)
+        return (None, None, None, None, None, *_pose_gradients(weighted, ctx.shared, ctx.like))
 
 
 class _SceneContacts(torch.autograd.Function):
@@ -309,13 +315,7 @@ class _ShapePairs(torch.autograd.Function):
                 shape_grads.append(
                     _tensor(f"the gradient of {name}'s parameters", np.asarray(total), ctx.like)
                 )
-        weighted = pose_gradient * weights.unsqueeze(1)
-        pose_grads = []
-        for (name, columns), shared in zip(_POSE_COLUMNS.items(), ctx.shared):
-            part = weighted[:, columns]
-            if shared:
-                part = part.sum(0, keepdim=True)
-            pose_grads.append(_tensor(f"the gradient of {name}", part.numpy(), ctx.like))
+        pose_grads = _pose_gradients(pose_gradient * weights.unsqueeze(1), ctx.shared, ctx.like)
         return (None, None, None, None, None, *shape_grads, *pose_grads)
 
 
