@@ -232,8 +232,7 @@ TEST(ArmShelf, SolvedMotionIsCheckedIndependently) {
   EXPECT_NEAR(at_knots, arm_shelf_path_min_distance(problem, result.states, 1), 1e-12);
 
   // Ipopt on the same problem from the same guess: feasible, the same cost within 0.5%.
-  const ProblemIpoptRun ipopt =
-      solve_problem_with_ipopt(problem, s.start, problem.retreat_controls());
+  const IpoptRun ipopt = solve_problem_with_ipopt(problem, s.start, problem.retreat_controls());
   EXPECT_TRUE(ipopt.solved) << ipopt.status;
   EXPECT_LE(ipopt.max_violation, 1e-6);
   EXPECT_NEAR(ipopt.cost, result.cost, 5e-3 * result.cost);

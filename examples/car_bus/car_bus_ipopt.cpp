@@ -1,11 +1,10 @@
 #include "car_bus_ipopt.hpp"
 
-#include <IpIpoptApplication.hpp>
-#include <IpSolveStatistics.hpp>
 #include <IpTNLP.hpp>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+
+#include "ipopt/timed_solve.hpp"
 
 namespace diffpills::examples {
 namespace {
@@ -198,38 +197,10 @@ class CarBusNlp : public Ipopt::TNLP {
 
 IpoptRun solve_with_ipopt(const CarBusProblem& problem,
                           const std::vector<Eigen::VectorXd>& initial_controls) {
-  std::vector<Eigen::VectorXd> states{problem.scenario().x0};
-  for (const Eigen::VectorXd& u : initial_controls) {
-    Eigen::VectorXd next;
-    Eigen::MatrixXd A, B;
-    problem.dynamics(states.back(), u, next, A, B);
-    states.push_back(next);
-  }
+  const std::vector<Eigen::VectorXd> states =
+      rollout(problem, problem.scenario().x0, initial_controls);
   Ipopt::SmartPtr<CarBusNlp> nlp = new CarBusNlp(problem, states, initial_controls);
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
-  app->Options()->SetNumericValue("tol", 1e-8);
-  app->Options()->SetNumericValue("constr_viol_tol", 1e-6);
-  app->Options()->SetIntegerValue("max_iter", 3000);
-  app->Options()->SetIntegerValue("print_level", 0);
-  app->Options()->SetStringValue("sb", "yes");  // no banner
-  Ipopt::ApplicationReturnStatus status = app->Initialize();
-  double solve_ms = 0.0;
-  if (status == Ipopt::Solve_Succeeded) {  // the solve alone is timed, not option parsing
-    const auto start = std::chrono::steady_clock::now();
-    status = app->OptimizeTNLP(nlp);
-    const std::chrono::duration<double, std::milli> elapsed =
-        std::chrono::steady_clock::now() - start;
-    solve_ms = elapsed.count();
-  }
-  IpoptRun run = nlp->run;
-  run.solve_ms = solve_ms;
-  run.status =
-      status == Ipopt::Solve_Succeeded ? "solved" : "failed (" + std::to_string(status) + ")";
-  if (Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics(); IsValid(statistics)) {
-    run.iterations = statistics->IterationCount();
-  }
-  return run;
+  return solve_timed(nlp, nlp->run);
 }
 
 }  // namespace diffpills::examples

@@ -9,22 +9,12 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <string>
 #include <vector>
 
 #include "car_bus.hpp"
+#include "ipopt/ipopt_run.hpp"
 
 namespace diffpills::examples {
-
-struct IpoptRun {
-  bool solved = false;
-  std::string status;
-  int iterations = 0;
-  double cost = 0.0;
-  double max_violation = 0.0;  // dynamics defects, phi < 0, bounds
-  double solve_ms = 0.0;
-  std::vector<Eigen::VectorXd> states, controls;
-};
 
 // Starts from the rollout of initial_controls, as ALTRO does.
 IpoptRun solve_with_ipopt(const CarBusProblem& problem,

@@ -129,12 +129,7 @@ void write_arm_shelf_json(const ArmShelfProblem& problem, const ArmShelfRun& run
                     {"path_min_distance", run.path_min_distance},
                     {"straight_line_min_distance", run.straight_line_min_distance},
                     {"solver", altro_summary(run.result, run.solve_ms)},
-                    {"ipopt",
-                     {{"status", run.ipopt.status},
-                      {"iterations", run.ipopt.iterations},
-                      {"max_violation", run.ipopt.max_violation},
-                      {"cost", run.ipopt.cost},
-                      {"solve_ms", run.ipopt.solve_ms}}}};
+                    {"ipopt", ipopt_summary(run.ipopt)}};
   std::ofstream(path) << out.dump(2) << "\n";
 }
 

@@ -17,7 +17,7 @@ struct ArmShelfRun {
   double min_distance = 0.0;       // smallest signed distance over the checked pairs and knots
   double path_min_distance = 0.0;  // the same between knots too, 20 samples per step
   double straight_line_min_distance = 0.0;  // over the straight line's knots
-  ProblemIpoptRun ipopt;
+  IpoptRun ipopt;
 };
 
 // The fastest of three ALTRO solves (not a cold-cache outlier) and one Ipopt solve, both from the

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "diffpills/trajopt/altro.hpp"
+#include "ipopt/ipopt_run.hpp"
 
 namespace diffpills::examples {
 
@@ -14,5 +15,8 @@ nlohmann::ordered_json json_list(const Eigen::VectorXd& v);
 // The "solver" block: name, status, iterations, outer and polish iterations, max_violation, cost
 // and solve_ms.
 nlohmann::ordered_json altro_summary(const trajopt::AltroResult& result, double solve_ms);
+
+// The "ipopt" block: status, iterations, max_violation, cost and solve_ms.
+nlohmann::ordered_json ipopt_summary(const IpoptRun& run);
 
 }  // namespace diffpills::examples

@@ -26,6 +26,7 @@ namespace {
 using namespace diffpills;
 using json = nlohmann::ordered_json;
 using examples::altro_summary;
+using examples::ipopt_summary;
 using examples::json_list;
 
 struct CarBusRun {
@@ -95,12 +96,7 @@ void write_car_bus_json(const examples::CarBusProblem& problem, const CarBusRun&
                     {"control_limit", json_list(s.control_limit)},
                     {"initial_guess_min_phi", run.guess_min_phi},
                     {"solver", altro_summary(run.result, run.solve_ms)},
-                    {"ipopt",
-                     {{"status", run.ipopt.status},
-                      {"iterations", run.ipopt.iterations},
-                      {"max_violation", run.ipopt.max_violation},
-                      {"cost", run.ipopt.cost},
-                      {"solve_ms", run.ipopt.solve_ms}}}};
+                    {"ipopt", ipopt_summary(run.ipopt)}};
   std::ofstream(path) << out.dump(2) << "\n";
 }
 

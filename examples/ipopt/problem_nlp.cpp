@@ -1,11 +1,10 @@
 #include "problem_nlp.hpp"
 
-#include <IpIpoptApplication.hpp>
-#include <IpSolveStatistics.hpp>
 #include <IpTNLP.hpp>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+
+#include "timed_solve.hpp"
 
 namespace diffpills::examples {
 namespace {
@@ -39,7 +38,7 @@ class ProblemNlp : public Ipopt::TNLP {
     constraints_ = offset;
   }
 
-  ProblemIpoptRun run;
+  IpoptRun run;
 
   bool get_nlp_info(Index& n, Index& m, Index& nnz_jac, Index& nnz_hess,
                     IndexStyleEnum& style) override {
@@ -227,40 +226,11 @@ class ProblemNlp : public Ipopt::TNLP {
 
 }  // namespace
 
-ProblemIpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
-                                         const std::vector<Eigen::VectorXd>& initial_controls) {
-  std::vector<Eigen::VectorXd> states{x0};
-  for (const Eigen::VectorXd& u : initial_controls) {
-    Eigen::VectorXd next;
-    Eigen::MatrixXd A, B;
-    problem.dynamics(states.back(), u, next, A, B);
-    states.push_back(next);
-  }
+IpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
+                                  const std::vector<Eigen::VectorXd>& initial_controls) {
+  const std::vector<Eigen::VectorXd> states = rollout(problem, x0, initial_controls);
   Ipopt::SmartPtr<ProblemNlp> nlp = new ProblemNlp(problem, x0, states, initial_controls);
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
-  app->Options()->SetNumericValue("tol", 1e-8);
-  app->Options()->SetNumericValue("constr_viol_tol", 1e-6);
-  app->Options()->SetIntegerValue("max_iter", 3000);
-  app->Options()->SetIntegerValue("print_level", 0);
-  app->Options()->SetStringValue("sb", "yes");  // no banner
-  Ipopt::ApplicationReturnStatus status = app->Initialize();
-  double solve_ms = 0.0;
-  if (status == Ipopt::Solve_Succeeded) {  // the solve alone is timed, not option parsing
-    const auto start = std::chrono::steady_clock::now();
-    status = app->OptimizeTNLP(nlp);
-    const std::chrono::duration<double, std::milli> elapsed =
-        std::chrono::steady_clock::now() - start;
-    solve_ms = elapsed.count();
-  }
-  ProblemIpoptRun run = nlp->run;
-  run.solve_ms = solve_ms;
-  run.status =
-      status == Ipopt::Solve_Succeeded ? "solved" : "failed (" + std::to_string(status) + ")";
-  if (Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics(); IsValid(statistics)) {
-    run.iterations = statistics->IterationCount();
-  }
-  return run;
+  return solve_timed(nlp, nlp->run);
 }
 
 }  // namespace diffpills::examples

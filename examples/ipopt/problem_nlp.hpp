@@ -9,24 +9,14 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <string>
 #include <vector>
 
 #include "diffpills/trajopt/problem.hpp"
+#include "ipopt_run.hpp"
 
 namespace diffpills::examples {
 
-struct ProblemIpoptRun {
-  bool solved = false;
-  std::string status;
-  int iterations = 0;
-  double cost = 0.0;
-  double max_violation = 0.0;  // dynamics defects, |e|, positive c
-  double solve_ms = 0.0;
-  std::vector<Eigen::VectorXd> states, controls;
-};
-
-ProblemIpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
-                                         const std::vector<Eigen::VectorXd>& initial_controls);
+IpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
+                                  const std::vector<Eigen::VectorXd>& initial_controls);
 
 }  // namespace diffpills::examples

@@ -1,0 +1,17 @@
+// The solve of the Ipopt cross-checks, with one set of options (used by problem_nlp.cpp and
+// car_bus_ipopt.cpp only: it needs Ipopt's headers, which the examples' users do not).
+#pragma once
+
+#include <IpTNLP.hpp>
+
+#include "ipopt_run.hpp"
+
+namespace diffpills::examples {
+
+// Solves nlp with Ipopt's limited-memory Hessian, tol 1e-8, constr_viol_tol 1e-6 and at most
+// 3,000 iterations, timing the solve alone (not option parsing). `result` is where the NLP's
+// finalize_solution writes, read after the solve; the run returned is it with the status, the
+// iteration count and the time.
+IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& result);
+
+}  // namespace diffpills::examples
