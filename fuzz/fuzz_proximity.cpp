@@ -17,7 +17,11 @@
 //   - the signed distance: finite, a unit normal, swap symmetry, points[1] - points[0] =
 //     distance * normal with the witnesses on the cores, and agreement with proximity()'s
 //     closest points where the cores are apart (distance + R1 + R2 = |p1 - p2|) or at most
-//     -(R1 + R2) where they intersect.
+//     -(R1 + R2) where they intersect;
+//   - second order and shapes (one pair in two): proximity_hessian and signed_distance_hessian
+//     repeat the first-order answer bit for bit and give a finite, exactly symmetric Hessian (and
+//     a finite normal Jacobian); the shape gradients are finite, with a row per given row and
+//     the same phi / distance as the plain calls.
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <Eigen/Core>
@@ -278,6 +282,55 @@ void check_signed_distance(const Shape& a, const Pose& pose_a, const Shape& b, c
   }
 }
 
+bool finite_shape_gradient(const diffpills::ShapeGradient& gradient, const Shape& shape) {
+  if (const auto* capsule = std::get_if<diffpills::CapsuleShapeGradient>(&gradient)) {
+    return std::holds_alternative<Capsule>(shape) && std::isfinite(capsule->length) &&
+           std::isfinite(capsule->radius);
+  }
+  const auto& polygon = std::get<diffpills::PolygonShapeGradient>(gradient);
+  const auto* given = std::get_if<PaddedPolygon>(&shape);
+  return given != nullptr && polygon.C.rows() == given->constraint_matrix().rows() &&
+         polygon.d.size() == polygon.C.rows() && polygon.C.allFinite() && polygon.d.allFinite() &&
+         std::isfinite(polygon.radius);
+}
+
+void check_second_order(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                        const diffpills::ProximityJacobian& proximity) {
+  const diffpills::ProximityHessian hessian = diffpills::proximity_hessian(a, pose_a, b, pose_b);
+  check(hessian.phi == proximity.phi && hessian.gradient == proximity.gradient,
+        "proximity_hessian repeats proximity_jacobian", hessian.phi - proximity.phi);
+  check(hessian.hessian.allFinite(), "Hessian of phi is finite");
+  check(hessian.hessian == hessian.hessian.transpose(), "Hessian of phi is symmetric");
+
+  const diffpills::SignedDistanceJacobian first =
+      diffpills::signed_distance_jacobian(a, pose_a, b, pose_b);
+  const diffpills::SignedDistanceHessian second =
+      diffpills::signed_distance_hessian(a, pose_a, b, pose_b);
+  check(second.distance == first.distance && second.gradient == first.gradient,
+        "signed_distance_hessian repeats signed_distance_jacobian",
+        second.distance - first.distance);
+  check(second.hessian.allFinite() && second.normal_jacobian.allFinite(),
+        "Hessian of the signed distance and normal Jacobian are finite");
+  check(second.hessian == second.hessian.transpose(),
+        "Hessian of the signed distance is symmetric");
+
+  const diffpills::ProximityShapeGradient shape_phi =
+      diffpills::proximity_shape_gradient(a, pose_a, b, pose_b);
+  check(shape_phi.phi == proximity.phi, "proximity_shape_gradient repeats phi",
+        shape_phi.phi - proximity.phi);
+  check(finite_shape_gradient(shape_phi.shape_gradient[0], a) &&
+            finite_shape_gradient(shape_phi.shape_gradient[1], b),
+        "shape gradients of phi are finite, one row per given row");
+  const diffpills::SignedDistanceShapeGradient shape_distance =
+      diffpills::signed_distance_shape_gradient(a, pose_a, b, pose_b);
+  check(shape_distance.distance == first.distance,
+        "signed_distance_shape_gradient repeats distance",
+        shape_distance.distance - first.distance);
+  check(finite_shape_gradient(shape_distance.shape_gradient[0], a) &&
+            finite_shape_gradient(shape_distance.shape_gradient[1], b),
+        "shape gradients of the distance are finite, one row per given row");
+}
+
 // Every query on one valid pair, with the invariants above.
 void check_queries(FuzzedDataProvider& data, const Shape& a, const Pose& pose_a, const Shape& b,
                    const Pose& pose_b) {
@@ -304,6 +357,8 @@ void check_queries(FuzzedDataProvider& data, const Shape& a, const Pose& pose_a,
   if (with_reference && rows_of(a) <= 48 && rows_of(b) <= 48) {
     compare_with_interior_point(a, pose_a, b, pose_b, ab.phi, radii, scene);
   }
+
+  if (data.ConsumeBool()) check_second_order(a, pose_a, b, pose_b, ab);
 
   const Eigen::Index rows = data.ConsumeIntegralInRange<int>(0, 3);
   diffpills::PositionArray r_a(rows, 3), r_b(rows, 3);

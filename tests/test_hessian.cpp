@@ -5,8 +5,10 @@
 // shapes; phi's zero where the cores intersect.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "diffpills/diffpills.hpp"
 #include "support/random_shapes.hpp"
@@ -120,7 +122,9 @@ TEST(Hessian, SignedDistanceMatchesCentralDifferencesOfTheGradient) {
       }
       EXPECT_GE(checked, 600) << "too few smooth cases: the check would prove little";
       // Two segments' cores cross only on a set of measure zero: no penetration to expect there.
-      if (!(capsule_a && capsule_b)) EXPECT_GE(penetrating, 50) << "too few penetrating cases";
+      if (!(capsule_a && capsule_b)) {
+        EXPECT_GE(penetrating, 50) << "too few penetrating cases";
+      }
       std::printf("distance, capsules %d%d: %d checked (%d penetrating), %d at kinks, worst %.2g\n",
                   capsule_a, capsule_b, checked, penetrating, kinks, worst);
     }
@@ -166,6 +170,90 @@ TEST(Hessian, ScalesExactlyWithPowersOfTwo) {
       }
     }
   }
+}
+
+// A quaternion scaled by 2^k is the same attitude: its rows and columns of the Hessians scale
+// by 2^-k each (the normalization's 1 / |q|), at the extremes Pose accepts too (norms up to
+// ~1e70 and down to ~1e-39; fuzz_proximity found a NaN block at |q| = 1.5e70 in a scene of
+// positions 1e100, where q' M q overflowed).
+TEST(Hessian, ScalesWithTheQuaternionsNorm) {
+  Rng rng(34);
+  for (int trial = 0; trial < 100; ++trial) {
+    const TestShape ta = random_shape(rng, trial % 2 == 0), tb = random_shape(rng, trial % 3 == 0);
+    const Pose pa = random_pose(rng, 1.5), pb = random_pose(rng, 1.5);
+    for (const auto& [k1, k2] : {std::pair{232, -120}, std::pair{-120, 232}}) {
+      const Pose scaled_a(pa.r(), std::ldexp(1.0, k1) * pa.q());
+      const Pose scaled_b(pb.r(), std::ldexp(1.0, k2) * pb.q());
+      const std::array<Matrix14, 2> base = {
+          proximity_hessian(ta.shape, pa, tb.shape, pb).hessian,
+          signed_distance_hessian(ta.shape, pa, tb.shape, pb).hessian};
+      const std::array<Matrix14, 2> scaled = {
+          proximity_hessian(ta.shape, scaled_a, tb.shape, scaled_b).hessian,
+          signed_distance_hessian(ta.shape, scaled_a, tb.shape, scaled_b).hessian};
+      for (std::size_t measure = 0; measure < 2; ++measure) {
+        ASSERT_TRUE(scaled[measure].allFinite()) << "trial " << trial << " k1 " << k1;
+        for (int i = 0; i < 14; ++i) {
+          for (int j = 0; j < 14; ++j) {
+            const auto power = [k1 = k1, k2 = k2](int index) {
+              return index % 7 < 3 ? 0 : (index < 7 ? -k1 : -k2);
+            };
+            const double expected = std::ldexp(base[measure](i, j), power(i) + power(j));
+            EXPECT_LE(std::abs(scaled[measure](i, j) - expected),
+                      1e-13 * std::ldexp(base[measure].cwiseAbs().maxCoeff(), power(i) + power(j)))
+                << "measure " << measure << ", trial " << trial << " k1 " << k1 << " (" << i << ", "
+                << j << ")";
+          }
+        }
+      }
+    }
+  }
+}
+
+// The fuzzer's case: 77- and 51-gons of size ~1e70, the first posed with |q| = 1.5e70, the
+// second 1e100 away. Every block is finite, and q1's block is q1's unit block over |q1|^2.
+TEST(Hessian, FiniteAtExtremeQuaternionNormsAndDistances) {
+  const auto regular = [](int m, double d, double radius) {
+    Eigen::MatrixX2d C(m, 2);
+    for (int i = 0; i < m; ++i) {
+      C.row(i) << std::cos(2 * M_PI * i / m), std::sin(2 * M_PI * i / m);
+    }
+    return PaddedPolygon(C, Eigen::VectorXd::Constant(m, d), radius);
+  };
+  const PaddedPolygon a = regular(77, 1.0352619520185846e70, 0.0);
+  const PaddedPolygon b = regular(51, 4.1410478080743383e70, 7.9409338805090657e-23);
+  const Eigen::Vector4d q(1.0352619520185846e70, -3, 1.0352619520185846e70, -3);
+  const Pose pa(Eigen::Vector3d::Constant(1.0352619520185846e70), q);
+  const Pose unit_a(pa.r(), q.normalized());
+  const Pose pb(Eigen::Vector3d(-1.75, -2.5, -1e100), Eigen::Vector4d(0.5, 0.5, 0.5, 0.5));
+  const ProximityHessian h = proximity_hessian(a, pa, b, pb);
+  const SignedDistanceHessian s = signed_distance_hessian(a, pa, b, pb);
+  ASSERT_TRUE(h.hessian.allFinite());
+  ASSERT_TRUE(s.hessian.allFinite());
+  const Eigen::Matrix4d unit_block = proximity_hessian(a, unit_a, b, pb).hessian.block<4, 4>(3, 3);
+  const double norm_squared = q.squaredNorm();
+  EXPECT_LE((h.hessian.block<4, 4>(3, 3) * norm_squared - unit_block).norm(),
+            1e-12 * unit_block.norm());
+}
+
+// Two points whose gap is subnormal (fuzz_proximity: 5.2e-320): the normal's rate 1 / gap is
+// beyond the double range, so it is held fixed as at contact. Everything stays finite, and the
+// Hessian is then the fixed-normal one: zero in the positions (the distance is linear along the
+// fixed normal) and in the attitudes (the points are the poses' origins).
+TEST(Hessian, SubnormalGapHoldsTheNormalFixed) {
+  const Capsule point(0.0, 0.0);
+  const Eigen::Vector4d identity(1, 0, 0, 0);
+  for (const double gap : {5.1857130187497237e-320, 4.9406564584124654e-324, 1e-310}) {
+    const SignedDistanceHessian s = signed_distance_hessian(point, Pose({gap, 0.0, 0.0}, identity),
+                                                            point, Pose({0.0, 0.0, 0.0}, identity));
+    EXPECT_EQ(s.distance, gap);
+    EXPECT_TRUE(s.normal_jacobian.allFinite()) << gap;
+    EXPECT_TRUE(s.hessian.allFinite()) << gap;
+    EXPECT_EQ(s.hessian.cwiseAbs().maxCoeff(), 0.0) << gap;
+  }
+  // At a gap of 1e-300 the rate is representable and the normal turns: (I - n n') / gap.
+  const SignedDistanceHessian s = signed_distance_hessian(point, Pose({1e-300, 0.0, 0.0}, identity),
+                                                          point, Pose({0.0, 0.0, 0.0}, identity));
+  EXPECT_NEAR(s.hessian(1, 1), 1e300, 1e286);
 }
 
 // Swapping the shapes permutes the Hessian's blocks.

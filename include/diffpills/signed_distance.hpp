@@ -86,7 +86,9 @@ struct SignedDistanceJacobian : SignedDistance {
 // and nearest facet), elsewhere the derivative of the reported gradient along the reported
 // Jacobians (one of the one-sided choices; for a flat D with its fixed normal, the normal's
 // motion is 0). From the witness points' and the normal's Jacobians (src/proximity/
-// measure_hessian.hpp with w = -normal).
+// measure_hessian.hpp with w = -normal). A normal between points turns at 1 / gap: for a gap
+// below ~5.6e-309 (subnormal numbers) that rate is not representable, and the normal is held
+// fixed as where the cores touch (normal_jacobian 0), so that every entry stays finite.
 struct SignedDistanceHessian : SignedDistanceJacobian {
   Eigen::Matrix<double, 3, 14> normal_jacobian =
       Eigen::Matrix<double, 3, 14>::Zero();  // d normal / d[r1 q1 r2 q2]

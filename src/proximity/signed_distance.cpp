@@ -144,6 +144,16 @@ Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& p
         frame, pose_a, posed_a, pose_b, posed_b, solution, &out.normal_jacobian);
     out.hessian = detail::measure_hessian(pose_a, pose_b, out.core_points, out.core_points_jacobian,
                                           -out.normal, -out.normal_jacobian);
+    // A normal d / |d| turns at 1 / |d| per unit of motion, which exceeds the double range when
+    // the gap is below 1 / DBL_MAX ~ 5.6e-309 (a scene of subnormal numbers: fuzz_proximity, two
+    // points 5.2e-320 apart). There the normal is held fixed, as it is where the cores touch (the
+    // one-sided choice at a gap of zero), rather than returning infinities.
+    if (!out.normal_jacobian.allFinite() || !out.hessian.allFinite()) {
+      out.normal_jacobian.setZero();
+      out.hessian =
+          detail::measure_hessian(pose_a, pose_b, out.core_points, out.core_points_jacobian,
+                                  -out.normal, Eigen::Matrix<double, 3, 14>::Zero());
+    }
     return out;
   } else if constexpr (std::is_same_v<Result, SignedDistanceJacobian>) {
     return detail::make_signed_distance_jacobian(frame, pose_a, posed_a, pose_b, posed_b, solution);
