@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <random>
 #include <vector>
@@ -393,8 +394,12 @@ BENCHMARK(Batch_CapsuleCapsule_PythonPoses)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(Batch_HexagonHexagon)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
-// The motion-planning demo's problem, solved from its straight-line guess (issue 4's target:
-// <= 20 ms to max violation 1e-6).
+// The motion-planning problems, each solved by ALTRO and by Ipopt (with its limited-memory and
+// with its exact Hessian) from the same guess, every solver of a problem over the same number of
+// solves (Iterations below: 5 for the car-bus, 3 for the quadrotor, 1 for the arm, whose exact
+// Ipopt takes about a minute). One iteration is one solve, with Ipopt's setup.
+// Targets: car-bus <= 20 ms to max violation 1e-6 (issue 4); quadrotor <= 200 ms (issue 4);
+// arm < 1 s (issue 11).
 void CarBus_Altro(benchmark::State& state) {
   const examples::CarBusProblem problem{examples::CarBusScenario{}};
   const std::vector<Eigen::VectorXd> guess = problem.straight_line_controls();
@@ -402,16 +407,15 @@ void CarBus_Altro(benchmark::State& state) {
     benchmark::DoNotOptimize(trajopt::solve(problem, problem.scenario().x0, guess));
   }
 }
-// Ipopt on the same NLP from the same guess (issue 4: ALTRO >= 10x faster); one call is one
-// solve, with Ipopt's setup.
 void CarBus_Ipopt(benchmark::State& state) {
   const examples::CarBusProblem problem{examples::CarBusScenario{}};
   const std::vector<Eigen::VectorXd> guess = problem.straight_line_controls();
+  const auto hessian = static_cast<examples::IpoptHessian>(state.range(0));
   for (auto _ : state) {
-    benchmark::DoNotOptimize(examples::solve_with_ipopt(problem, guess).cost);
+    benchmark::DoNotOptimize(examples::solve_with_ipopt(problem, guess, hessian).cost);
   }
 }
-// The 3-D problem of issue 4 (target <= 200 ms): 13 states, 4 thrusts, 51 knots, six obstacles.
+// 13 states, 4 thrusts, 51 knots, six obstacles.
 void QuadrotorWindow_Altro(benchmark::State& state) {
   const examples::QuadrotorWindowProblem problem{examples::QuadrotorWindowScenario{}};
   const std::vector<Eigen::VectorXd> guess = problem.hover_controls();
@@ -419,8 +423,16 @@ void QuadrotorWindow_Altro(benchmark::State& state) {
     benchmark::DoNotOptimize(trajopt::solve(problem, problem.scenario().x0, guess));
   }
 }
-// The arm among the shelves (issue 11, target < 1 s): 7 joints, 41 knots, 85 shape pairs checked at
-// 4 points of every step through the scene query.
+void QuadrotorWindow_Ipopt(benchmark::State& state) {
+  const examples::QuadrotorWindowProblem problem{examples::QuadrotorWindowScenario{}};
+  const std::vector<Eigen::VectorXd> guess = problem.hover_controls();
+  const auto hessian = static_cast<examples::IpoptHessian>(state.range(0));
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        examples::solve_problem_with_ipopt(problem, problem.scenario().x0, guess, hessian).cost);
+  }
+}
+// 7 joints, 41 knots, 85 shape pairs checked at 4 points of every step through the scene query.
 void ArmShelf_Altro(benchmark::State& state) {
   const examples::ArmShelfProblem problem{examples::ArmShelfScenario{}};
   const std::vector<Eigen::VectorXd> guess = problem.retreat_controls();
@@ -432,16 +444,33 @@ void ArmShelf_Altro(benchmark::State& state) {
 void ArmShelf_Ipopt(benchmark::State& state) {
   const examples::ArmShelfProblem problem{examples::ArmShelfScenario{}};
   const std::vector<Eigen::VectorXd> guess = problem.retreat_controls();
+  const auto hessian = static_cast<examples::IpoptHessian>(state.range(0));
   for (auto _ : state) {
     benchmark::DoNotOptimize(
-        examples::solve_problem_with_ipopt(problem, problem.scenario().start, guess).cost);
+        examples::solve_problem_with_ipopt(problem, problem.scenario().start, guess, hessian).cost);
   }
 }
-BENCHMARK(CarBus_Altro)->Unit(benchmark::kMillisecond);
-BENCHMARK(QuadrotorWindow_Altro)->Unit(benchmark::kMillisecond);
-BENCHMARK(ArmShelf_Altro)->Unit(benchmark::kMillisecond);
-BENCHMARK(CarBus_Ipopt)->Unit(benchmark::kMillisecond);
-BENCHMARK(ArmShelf_Ipopt)->Unit(benchmark::kMillisecond)->Iterations(3);
+// Argument 0: Ipopt's limited-memory Hessian, 1: exact (examples::IpoptHessian).
+constexpr auto kLimitedMemory = static_cast<std::int64_t>(examples::IpoptHessian::kLimitedMemory);
+constexpr auto kExact = static_cast<std::int64_t>(examples::IpoptHessian::kExact);
+BENCHMARK(CarBus_Altro)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(CarBus_Ipopt)
+    ->Arg(kLimitedMemory)
+    ->Arg(kExact)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(5);
+BENCHMARK(QuadrotorWindow_Altro)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(QuadrotorWindow_Ipopt)
+    ->Arg(kLimitedMemory)
+    ->Arg(kExact)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+BENCHMARK(ArmShelf_Altro)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(ArmShelf_Ipopt)
+    ->Arg(kLimitedMemory)
+    ->Arg(kExact)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 BENCHMARK(CapsuleCapsule_FclDistance);
 BENCHMARK(CapsuleCapsule_Proximity);

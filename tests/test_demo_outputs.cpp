@@ -2,7 +2,9 @@
 // program (its path is the first argument) into a fresh folder and reads everything back, then
 // checks that each CSV row follows from the previous one by RK4 of the documented model, with the
 // parameters the JSON files state; and the arm's motion from the JSON's own description alone
-// (its DH parameters, links, exclusions and shelf): limits, start, goal and the signed distances.
+// (its DH parameters, links, exclusions and shelf): limits, start, goal and the signed distances;
+// and the Ipopt comparison's blocks. The demo runs with --quick (each solver once, Ipopt on the
+// car-bus problem only: the other Ipopt runs take minutes under the sanitizers).
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -14,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "diffpills/diffpills.hpp"
@@ -30,13 +33,14 @@ std::string read(const std::filesystem::path& path) {
   return buffer.str();
 }
 
-// Runs the demo once into a fresh folder; both tests read it.
+// Runs the demo once into a fresh folder; every test reads it.
 const std::filesystem::path& demo_folder() {
   static const std::filesystem::path out = [] {
     const std::filesystem::path folder =
         std::filesystem::temp_directory_path() / "diffpills_demo_test";
     std::filesystem::remove_all(folder);
-    const int status = std::system((demo_program + " " + folder.string() + " > /dev/null").c_str());
+    const int status =
+        std::system((demo_program + " " + folder.string() + " --quick > /dev/null").c_str());
     EXPECT_EQ(status, 0);
     return folder;
   }();
@@ -269,6 +273,35 @@ TEST(DemoOutputs, ArmShelfFromItsOwnDescription) {
   EXPECT_NEAR(smallest, arm["min_distance"].get<double>(), 1e-9);
   EXPECT_LT(arm["straight_line_min_distance"].get<double>(), 0.0);
   EXPECT_EQ(read(out / "arm_shelf.svg").rfind("<svg", 0), 0u);
+}
+
+// Both Ipopt runs of the car-bus problem are there, name their Hessian, solve, agree with ALTRO's
+// cost, and the speed-up is the faster one's time over ALTRO's. (Without --quick the quadrotor and
+// the arm carry the same blocks.)
+TEST(DemoOutputs, IpoptComparison) {
+  const std::filesystem::path& out = demo_folder();
+  const nlohmann::json car_bus = nlohmann::json::parse(read(out / "car_bus.json"));
+  const double altro_ms = car_bus["solver"]["solve_ms"], altro_cost = car_bus["solver"]["cost"];
+  double faster = INFINITY;
+  std::string faster_name;
+  for (const auto& [key, hessian] :
+       {std::pair{"ipopt", "limited-memory"}, std::pair{"ipopt_exact", "exact"}}) {
+    const nlohmann::json& run = car_bus.at(key);
+    EXPECT_EQ(run["hessian"], hessian);
+    EXPECT_EQ(run["status"], "solved");
+    EXPECT_LE(run["max_violation"].get<double>(), 1e-6);
+    EXPECT_NEAR(run["cost"].get<double>(), altro_cost, 1e-3 * altro_cost) << key;
+    if (run["solve_ms"].get<double>() < faster) {
+      faster = run["solve_ms"];
+      faster_name = hessian;
+    }
+  }
+  EXPECT_EQ(car_bus["altro_speedup"]["over"], faster_name);
+  EXPECT_DOUBLE_EQ(car_bus["altro_speedup"]["ratio"].get<double>(), faster / altro_ms);
+  EXPECT_EQ(car_bus["altro_speedup"]["runs"], 1);
+  for (const char* quick_only : {"quadrotor_window.json", "arm_shelf.json"}) {
+    EXPECT_FALSE(nlohmann::json::parse(read(out / quick_only)).contains("ipopt")) << quick_only;
+  }
 }
 
 }  // namespace

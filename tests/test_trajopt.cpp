@@ -13,6 +13,7 @@
 #include "diffpills/trajopt/altro.hpp"
 #include "diffpills/trajopt/car.hpp"
 #include "diffpills/trajopt/rk4.hpp"
+#include "ipopt/problem_nlp.hpp"
 
 namespace diffpills::trajopt {
 namespace {
@@ -292,19 +293,49 @@ TEST(Trajopt, CarPassesTheBusAndReachesTheGoal) {
     }
   }
   EXPECT_LE((result.states.back().head<3>() - s.goal.head<3>()).cwiseAbs().maxCoeff(), 1e-6);
-  // Ipopt on the same NLP from the same guess: feasible, and the same cost within 1%.
-  const examples::IpoptRun ipopt = examples::solve_with_ipopt(problem, guess);
-  ASSERT_TRUE(ipopt.solved) << ipopt.status;
-  EXPECT_LE(ipopt.max_violation, 1e-6);
-  for (const VectorXd& xk : ipopt.states) {
-    EXPECT_GE(proximity(s.car, examples::car_pose(xk), s.bus, s.bus_pose).phi, -1e-6);
+  // Ipopt on the same NLP from the same guess, with either Hessian, and the generic NLP of any
+  // Problem (problem_nlp.hpp) with either: feasible, and the same cost within 1%.
+  for (const examples::IpoptHessian hessian :
+       {examples::IpoptHessian::kLimitedMemory, examples::IpoptHessian::kExact}) {
+    for (const bool generic : {false, true}) {
+      const examples::IpoptRun ipopt =
+          generic ? examples::solve_problem_with_ipopt(problem, s.x0, guess, hessian)
+                  : examples::solve_with_ipopt(problem, guess, hessian);
+      const std::string name =
+          std::string(examples::to_string(hessian)) + (generic ? ", generic NLP" : ", car-bus NLP");
+      ASSERT_TRUE(ipopt.solved) << ipopt.status << " " << name;
+      EXPECT_EQ(ipopt.hessian, hessian);
+      EXPECT_LE(ipopt.max_violation, 1e-6) << name;
+      for (const VectorXd& xk : ipopt.states) {
+        EXPECT_GE(proximity(s.car, examples::car_pose(xk), s.bus, s.bus_pose).phi, -1e-6) << name;
+      }
+      EXPECT_LE(std::abs(ipopt.cost - result.cost), 0.01 * std::abs(ipopt.cost)) << name;
+      std::cout << "[car-bus] Ipopt (" << name << "): " << ipopt.iterations << " iterations, cost "
+                << ipopt.cost << ", ALTRO cost " << result.cost << "\n";
+    }
   }
-  EXPECT_LE(std::abs(ipopt.cost - result.cost), 0.01 * std::abs(ipopt.cost));
-  std::cout << "[car-bus] Ipopt: " << ipopt.iterations << " iterations, cost " << ipopt.cost
-            << ", ALTRO cost " << result.cost << "\n";
   std::cout << "[car-bus] iterations " << result.iterations << " (outer " << result.outer_iterations
             << "), cost " << result.cost << ", max violation " << result.max_violation
             << ", straight-line guess min phi " << guess_min_phi << "\n";
+}
+
+// The exact-Hessian Ipopt needs a problem's second derivatives: without them it refuses (the
+// default dynamics_hessian and constraint_hessian throw std::logic_error if called anyway).
+TEST(Ipopt, ExactHessianNeedsSecondDerivatives) {
+  const LinearQuadratic problem(MatrixXd::Identity(1, 1), MatrixXd::Identity(1, 1),
+                                MatrixXd::Identity(1, 1), MatrixXd::Identity(1, 1),
+                                MatrixXd::Identity(1, 1), 3);
+  EXPECT_FALSE(problem.has_second_derivatives());
+  const std::vector<VectorXd> guess(2, VectorXd::Zero(1));
+  EXPECT_THROW(examples::solve_problem_with_ipopt(problem, VectorXd::Ones(1), guess,
+                                                  examples::IpoptHessian::kExact),
+               std::invalid_argument);
+  EXPECT_THROW(problem.dynamics_hessian(VectorXd::Zero(1), VectorXd::Zero(1), VectorXd::Zero(1)),
+               std::logic_error);
+  EXPECT_THROW(problem.constraint_hessian(0, VectorXd::Zero(1), VectorXd::Zero(1), VectorXd()),
+               std::logic_error);
+  // The limited-memory Hessian needs none.
+  EXPECT_TRUE(examples::solve_problem_with_ipopt(problem, VectorXd::Ones(1), guess).solved);
 }
 
 }  // namespace

@@ -36,6 +36,13 @@ Body board(const std::string& name, const Eigen::Vector3d& centre, double h1, do
 
 constexpr int kLinks = 9;  // frames 0 .. 8
 
+// A knot's rows (ArmShelfProblem::constraints): the goal (last knot), the joint limits, the
+// velocity limits (not at the last knot), then the collision rows.
+int goal_rows(bool last) { return last ? 7 : 0; }
+constexpr int kLimitRows = 14;
+int velocity_rows(bool last) { return last ? 0 : 14; }
+int collision_start(bool last) { return goal_rows(last) + kLimitRows + velocity_rows(last); }
+
 }  // namespace
 
 PandaArm panda_arm() {
@@ -174,12 +181,11 @@ trajopt::KnotConstraints ArmShelfProblem::evaluate(int k, const Eigen::VectorXd&
                                                    const Eigen::VectorXd& u,
                                                    bool derivatives) const {
   const bool last = k == knots() - 1;
-  const int goal_rows = last ? 7 : 0, limit_rows = 14, velocity_rows = last ? 0 : 14;
-  const int collision_start = goal_rows + limit_rows + velocity_rows;
+  const int goals = goal_rows(last), first_collision = collision_start(last);
   const int rows =
-      collision_start + (last ? 1 : scenario_.substeps) * static_cast<int>(pairs_.size());
+      first_collision + (last ? 1 : scenario_.substeps) * static_cast<int>(pairs_.size());
   trajopt::KnotConstraints out;
-  out.equalities = goal_rows;
+  out.equalities = goals;
   out.value.resize(rows);
   if (derivatives) {
     out.dx = Eigen::MatrixXd::Zero(rows, 7);
@@ -190,14 +196,14 @@ trajopt::KnotConstraints ArmShelfProblem::evaluate(int k, const Eigen::VectorXd&
     out.value.head(7) = x - scenario_.goal;
     if (derivatives) out.dx.topRows(7).setIdentity();
   }
-  out.value.segment(goal_rows, 7) = x - limits.col(1);
-  out.value.segment(goal_rows + 7, 7) = limits.col(0) - x;
+  out.value.segment(goals, 7) = x - limits.col(1);
+  out.value.segment(goals + 7, 7) = limits.col(0) - x;
   if (derivatives) {
-    out.dx.block(goal_rows, 0, 7, 7).setIdentity();
-    out.dx.block(goal_rows + 7, 0, 7, 7) = -Eigen::MatrixXd::Identity(7, 7);
+    out.dx.block(goals, 0, 7, 7).setIdentity();
+    out.dx.block(goals + 7, 0, 7, 7) = -Eigen::MatrixXd::Identity(7, 7);
   }
   if (!last) {
-    const int v = goal_rows + limit_rows;
+    const int v = goals + kLimitRows;
     out.value.segment(v, 7) = u - scenario_.arm.velocity_limits;
     out.value.segment(v + 7, 7) = -scenario_.arm.velocity_limits - u;
     if (derivatives) {
@@ -209,14 +215,14 @@ trajopt::KnotConstraints ArmShelfProblem::evaluate(int k, const Eigen::VectorXd&
   // and the next knot, q = x + (s / S) dt u. Pairs the query does not report are more than the
   // margin apart: their row is the constant clearance - margin.
   const auto pair_count = static_cast<Eigen::Index>(pairs_.size());
-  out.value.tail(rows - collision_start).setConstant(scenario_.clearance - scenario_.query_margin);
+  out.value.tail(rows - first_collision).setConstant(scenario_.clearance - scenario_.query_margin);
   const int substeps = last ? 1 : scenario_.substeps;
   for (int step = 0; step < substeps; ++step) {
     const double fraction = static_cast<double>(step) / scenario_.substeps;
     const Eigen::VectorXd q = last ? x : Eigen::VectorXd(x + fraction * scenario_.dt * u);
     trajopt::ChainFrames frames;
     const std::vector<Pose> poses = arm_shelf_poses(scenario_, q, derivatives ? &frames : nullptr);
-    const Eigen::Index first_row = collision_start + step * pair_count;
+    const Eigen::Index first_row = first_collision + step * pair_count;
     for (const Contact& contact : scene_.contacts(poses, scenario_.query_margin)) {
       const auto found = row_of_.find(
           {contact.bodies[0], contact.bodies[1], contact.shapes[0], contact.shapes[1]});
@@ -240,6 +246,82 @@ trajopt::KnotConstraints ArmShelfProblem::evaluate(int k, const Eigen::VectorXd&
     }
   }
   return out;
+}
+
+Eigen::MatrixXd ArmShelfProblem::dynamics_hessian(const Eigen::VectorXd&, const Eigen::VectorXd&,
+                                                  const Eigen::VectorXd&) const {
+  return Eigen::MatrixXd::Zero(14, 14);  // x + dt u is linear
+}
+
+// Each shape's world pose is fixed in its link's frame f (or in the world, for a board):
+// p = o_f + Q(q_f) r_l, q_p = q_f (x) q_l / |q_l|, the way the scene composes it. With J_s its
+// Jacobian and C_s its curvature term for the distance's gradient (serial_chain.hpp), the Hessian
+// of the distance in the joint angles is [J_1; J_2]' H [J_1; J_2] + C_1 + C_2, H the 14 x 14
+// Hessian of signed_distance_hessian at the two world poses.
+Eigen::MatrixXd ArmShelfProblem::contact_hessian(const Contact& contact,
+                                                 const trajopt::ChainFrames& frames) const {
+  std::array<Pose, 2> world;
+  for (std::size_t side = 0; side < 2; ++side) {
+    const BodyShape& shape = scene_.body(contact.bodies[side]).shapes()[contact.shapes[side]];
+    const Eigen::Vector4d local_attitude = shape.pose.q() / shape.pose.q().norm();
+    if (contact.bodies[side] >= 1 && contact.bodies[side] < kLinks) {
+      const auto f = static_cast<std::size_t>(contact.bodies[side]);
+      world[side] = Pose(frames.origin[f] + rotation_matrix(frames.attitude[f]) * shape.pose.r(),
+                         left_multiply_matrix(frames.attitude[f]) * local_attitude);
+    } else {
+      world[side] = Pose(shape.pose.r(), local_attitude);  // the base and the boards stay put
+    }
+  }
+  const auto& shape_of = [&](std::size_t side) -> const Shape& {
+    return scene_.body(contact.bodies[side]).shapes()[contact.shapes[side]].shape;
+  };
+  const SignedDistanceHessian distance =
+      signed_distance_hessian(shape_of(0), world[0], shape_of(1), world[1]);
+  Eigen::Matrix<double, 14, 7> J = Eigen::Matrix<double, 14, 7>::Zero();
+  Eigen::MatrixXd curvature = Eigen::MatrixXd::Zero(7, 7);
+  for (std::size_t side = 0; side < 2; ++side) {
+    const int body = contact.bodies[side];
+    if (body < 1 || body >= kLinks) continue;
+    const auto row = static_cast<Eigen::Index>(7 * side);
+    const trajopt::AttachedPoseDerivatives pose = trajopt::attached_pose_derivatives(
+        frames, body, world[side].r(), world[side].q(), distance.gradient.segment<7>(row));
+    J.middleRows<7>(row) = pose.jacobian;
+    curvature += pose.curvature;
+  }
+  return J.transpose() * distance.hessian * J + curvature;
+}
+
+// The goal, limit and velocity rows are linear. A collision row at substep s, clearance -
+// min(distance(q), margin) with q = x + c u, c = (s / S) dt, adds -mu times the distance's
+// Hessian in q, [I; c I]' H_q [I, c I] in [x; u], where the contact is within the margin (beyond
+// it the row is constant).
+Eigen::MatrixXd ArmShelfProblem::constraint_hessian(int k, const Eigen::VectorXd& x,
+                                                    const Eigen::VectorXd& u,
+                                                    const Eigen::VectorXd& mu) const {
+  const bool last = k == knots() - 1;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(7 + u.size(), 7 + u.size());
+  const auto pair_count = static_cast<Eigen::Index>(pairs_.size());
+  const int substeps = last ? 1 : scenario_.substeps;
+  for (int step = 0; step < substeps; ++step) {
+    const double c = static_cast<double>(step) / scenario_.substeps * scenario_.dt;
+    const Eigen::VectorXd q = last ? x : Eigen::VectorXd(x + c * u);
+    trajopt::ChainFrames frames;
+    const std::vector<Pose> poses = arm_shelf_poses(scenario_, q, &frames);
+    for (const Contact& contact : scene_.contacts(poses, scenario_.query_margin)) {
+      const auto found = row_of_.find(
+          {contact.bodies[0], contact.bodies[1], contact.shapes[0], contact.shapes[1]});
+      if (found == row_of_.end() || contact.distance >= scenario_.query_margin) continue;
+      const double weight = mu(collision_start(last) + step * pair_count + found->second);
+      if (weight == 0.0) continue;
+      const Eigen::MatrixXd H_q = -weight * contact_hessian(contact, frames);
+      H.topLeftCorner<7, 7>() += H_q;
+      if (last) continue;
+      H.topRightCorner<7, 7>() += c * H_q;
+      H.bottomLeftCorner<7, 7>() += c * H_q;
+      H.bottomRightCorner<7, 7>() += c * c * H_q;
+    }
+  }
+  return H;
 }
 
 std::vector<Eigen::VectorXd> ArmShelfProblem::straight_line_controls() const {

@@ -12,8 +12,8 @@
 // are never checked against each other (their shapes overlap at the joints), nor frames 2 and 4 or
 // 3 and 5, whose capsules overlap at the elbow in every configuration (both pairs at all of
 // 20,000 random joint angles within the limits), nor 5 and 7, whose crude capsules overlap when the
-// wrist is bent back (q6 > ~3.3, 20% of those angles) where the real links clear each other by the wrist's
-// 0.088 m offset; every other pair is a self-collision the solver avoids.
+// wrist is bent back (q6 > ~3.3, 20% of those angles) where the real links clear each other by the
+// wrist's 0.088 m offset; every other pair is a self-collision the solver avoids.
 //
 // The shelf: six padded-polygon boards (padding 0.01 m): bottom and top boards at heights 0.55 and
 // 0.87 m, from 0.40 to 0.80 m in front of the base and 0.45 m to either side, a back board and two
@@ -103,6 +103,14 @@ class ArmShelfProblem : public trajopt::Problem {
                                        const Eigen::VectorXd& u) const override;
   trajopt::KnotConstraints constraint_values(int k, const Eigen::VectorXd& x,
                                              const Eigen::VectorXd& u) const override;
+  // Exact second derivatives: the dynamics are linear and the cost quadratic; each collision row's
+  // Hessian chains signed_distance_hessian through the shapes' poses and the arm's forward
+  // kinematics (serial_chain.hpp's attached_pose_derivatives).
+  bool has_second_derivatives() const override { return true; }
+  Eigen::MatrixXd dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                   const Eigen::VectorXd& lambda) const override;
+  Eigen::MatrixXd constraint_hessian(int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                     const Eigen::VectorXd& mu) const override;
 
   const ArmShelfScenario& scenario() const { return scenario_; }
   const Scene& scene() const { return scene_; }
@@ -124,6 +132,8 @@ class ArmShelfProblem : public trajopt::Problem {
  private:
   trajopt::KnotConstraints evaluate(int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                     bool derivatives) const;
+  // The Hessian of a contact's signed distance with respect to the joint angles (7 x 7).
+  Eigen::MatrixXd contact_hessian(const Contact& contact, const trajopt::ChainFrames& frames) const;
 
   ArmShelfScenario scenario_;
   Scene scene_;

@@ -24,7 +24,38 @@ void state_gradient(const Eigen::Matrix<double, 14, 1>& g, const Eigen::VectorXd
   (*gradient)(2) = g.segment<4>(3).dot(dq_dtheta);
 }
 
+// The chain rule once more: with J = d pose / dx as above (rows r_x, r_y and q's four) and
+// d2q/dtheta2 = -q / 4, the state Hessian of a measure with pose Hessian H and gradient g is
+//   J' H J + (g_q . (-q / 4)) e_theta e_theta'.
+Eigen::Matrix<double, 5, 5> state_hessian(const Eigen::Matrix<double, 14, 14>& H,
+                                          const Eigen::Matrix<double, 14, 1>& g,
+                                          const Eigen::VectorXd& x) {
+  const Eigen::Vector4d q(std::cos(0.5 * x(2)), 0.0, 0.0, std::sin(0.5 * x(2)));
+  Eigen::Matrix<double, 7, 5> J = Eigen::Matrix<double, 7, 5>::Zero();
+  J(0, 0) = 1.0;
+  J(1, 1) = 1.0;
+  J.block<4, 1>(3, 2) = Eigen::Vector4d(-0.5 * q(3), 0.0, 0.0, 0.5 * q(0));  // dq/dtheta
+  Eigen::Matrix<double, 5, 5> out = J.transpose() * H.topLeftCorner<7, 7>() * J;
+  out(2, 2) -= 0.25 * g.segment<4>(3).dot(q);
+  return out;
+}
+
 }  // namespace
+
+Eigen::Matrix<double, 5, 5> car_bus_phi_hessian(const CarBusScenario& scenario,
+                                                const Eigen::VectorXd& x) {
+  const ProximityHessian p =
+      proximity_hessian(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
+  return state_hessian(p.hessian, p.gradient, x);
+}
+
+Eigen::Matrix<double, 5, 5> car_bus_clearance_hessian(const CarBusScenario& scenario,
+                                                      const Eigen::VectorXd& x) {
+  if (scenario.clearance == Clearance::kProximity) return car_bus_phi_hessian(scenario, x);
+  const SignedDistanceHessian s =
+      signed_distance_hessian(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
+  return state_hessian(s.hessian, s.gradient, x);
+}
 
 double car_bus_phi(const CarBusScenario& scenario, const Eigen::VectorXd& x,
                    Eigen::VectorXd* gradient) {
@@ -57,6 +88,22 @@ void CarBusProblem::dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
   next = fixed_next;
   A = fixed_A;
   B = fixed_B;
+}
+
+Eigen::MatrixXd CarBusProblem::dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                                const Eigen::VectorXd& lambda) const {
+  return scenario_.car_model.step_hessian(scenario_.dt, x, u, lambda);
+}
+
+// Only the clearance row (after the last knot's three equalities) is nonlinear; at the last knot
+// the Hessian is in x alone.
+Eigen::MatrixXd CarBusProblem::constraint_hessian(int k, const Eigen::VectorXd& x,
+                                                  const Eigen::VectorXd& u,
+                                                  const Eigen::VectorXd& mu) const {
+  const bool last = k == scenario_.knots - 1;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(5 + u.size(), 5 + u.size());
+  H.topLeftCorner<5, 5>() = -mu(last ? 3 : 0) * car_bus_clearance_hessian(scenario_, x);
+  return H;
 }
 
 trajopt::CostExpansion CarBusProblem::stage_cost(int, const Eigen::VectorXd& x,

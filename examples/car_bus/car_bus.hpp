@@ -33,10 +33,16 @@ double car_bus_phi(const CarBusScenario& scenario, const Eigen::VectorXd& x,
 // The scenario's clearance measure (phi or the signed distance) and its state gradient.
 double car_bus_clearance(const CarBusScenario& scenario, const Eigen::VectorXd& x,
                          Eigen::VectorXd* gradient = nullptr);
+// The Hessian with respect to the state (5 x 5, through the pose) of phi, or of the given measure.
+Eigen::Matrix<double, 5, 5> car_bus_phi_hessian(const CarBusScenario& scenario,
+                                                const Eigen::VectorXd& x);
+Eigen::Matrix<double, 5, 5> car_bus_clearance_hessian(const CarBusScenario& scenario,
+                                                      const Eigen::VectorXd& x);
 
 // Costs 1/2 (x - goal)'Q(x - goal) + 1/2 u'Ru per knot and 1/2 (x - goal)'Qf(x - goal) at the
 // end; constraints -clearance <= 0 at every knot (phi or the signed distance), |u| <= control_limit
-// at every control, and the final position and heading equal to the goal's.
+// at every control, and the final position and heading equal to the goal's. With exact second
+// derivatives of all of these (the costs are quadratic).
 class CarBusProblem : public trajopt::Problem {
  public:
   explicit CarBusProblem(CarBusScenario scenario);
@@ -55,6 +61,11 @@ class CarBusProblem : public trajopt::Problem {
   double terminal_cost_value(const Eigen::VectorXd& x) const override;
   trajopt::KnotConstraints constraint_values(int k, const Eigen::VectorXd& x,
                                              const Eigen::VectorXd& u) const override;
+  bool has_second_derivatives() const override { return true; }
+  Eigen::MatrixXd dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                   const Eigen::VectorXd& lambda) const override;
+  Eigen::MatrixXd constraint_hessian(int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                     const Eigen::VectorXd& mu) const override;
 
   const CarBusScenario& scenario() const { return scenario_; }
   // Straight ahead along the initial heading: accelerate for half the horizon, brake for the

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ipopt/knot_hessian.hpp"
 #include "ipopt/timed_solve.hpp"
 
 namespace diffpills::examples {
@@ -35,7 +36,8 @@ class CarBusNlp : public Ipopt::TNLP {
       : problem_(problem),
         layout_{problem.knots()},
         guess_states_(std::move(guess_states)),
-        guess_controls_(std::move(guess_controls)) {}
+        guess_controls_(std::move(guess_controls)),
+        hessian_(kState, kControl, layout_.knots) {}
 
   IpoptRun run;
 
@@ -46,7 +48,7 @@ class CarBusNlp : public Ipopt::TNLP {
     // Per defect block: I on x_{k+1}, -A on x_k, -B on u_k; per phi row: px, py, theta.
     nnz_jac =
         (layout_.knots - 1) * (kState + kState * kState + kState * kControl) + 3 * layout_.knots;
-    nnz_hess = 0;
+    nnz_hess = hessian_.nonzeros();
     style = C_STYLE;
     return true;
   }
@@ -135,6 +137,32 @@ class CarBusNlp : public Ipopt::TNLP {
     return true;
   }
 
+  // The Lagrangian obj_factor l(z) + lambda' g(z): per knot, the costs' Hessian, the defect's
+  // -f(x_k, u_k) weighted by its multipliers, and phi(x_k) weighted by its multiplier.
+  bool eval_h(Index, const Number* z, bool, Number obj_factor, Index, const Number* lambda, bool,
+              Index, Index* rows, Index* cols, Number* values) override {
+    if (values == nullptr) {
+      hessian_.structure(rows, cols);
+      return true;
+    }
+    std::fill(values, values + hessian_.nonzeros(), 0.0);
+    for (int k = 0; k < layout_.knots; ++k) {
+      const Eigen::VectorXd x = state(z, k);
+      const bool last = k + 1 == layout_.knots;
+      const Eigen::VectorXd u = last ? Eigen::VectorXd() : control(z, k);
+      Eigen::MatrixXd block =
+          cost_block(last ? problem_.terminal_cost(x) : problem_.stage_cost(k, x, u), obj_factor);
+      if (!last) {
+        const Eigen::Map<const Eigen::VectorXd> defect(lambda + layout_.state(k), kState);
+        block += problem_.dynamics_hessian(x, u, -defect);
+      }
+      block.topLeftCorner<kState, kState>() +=
+          lambda[layout_.defects() + k] * car_bus_phi_hessian(problem_.scenario(), x);
+      hessian_.add(k, block, values);
+    }
+    return true;
+  }
+
   void finalize_solution(Ipopt::SolverReturn status, Index, const Number* z, const Number*,
                          const Number*, Index, const Number* g, const Number*, Number objective,
                          const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
@@ -191,16 +219,18 @@ class CarBusNlp : public Ipopt::TNLP {
   const CarBusProblem& problem_;
   Layout layout_;
   std::vector<Eigen::VectorXd> guess_states_, guess_controls_;
+  KnotHessian hessian_;
 };
 
 }  // namespace
 
 IpoptRun solve_with_ipopt(const CarBusProblem& problem,
-                          const std::vector<Eigen::VectorXd>& initial_controls) {
+                          const std::vector<Eigen::VectorXd>& initial_controls,
+                          IpoptHessian hessian) {
   const std::vector<Eigen::VectorXd> states =
       rollout(problem, problem.scenario().x0, initial_controls);
   Ipopt::SmartPtr<CarBusNlp> nlp = new CarBusNlp(problem, states, initial_controls);
-  return solve_timed(nlp, nlp->run);
+  return solve_timed(nlp, nlp->run, hessian);
 }
 
 }  // namespace diffpills::examples

@@ -5,7 +5,8 @@
 //   subject to  x_{k+1} - f(x_k, u_k) = 0,  phi(x_k) >= 0,
 //               x_0 = x0 and the final position and heading = goal (variable bounds),
 //               |u| <= control_limit (variable bounds)
-// with exact first derivatives and Ipopt's limited-memory Hessian approximation.
+// with exact first derivatives and either Ipopt's limited-memory Hessian approximation or the
+// exact Hessian of the Lagrangian (the costs', the car's RK4 step's and phi's through the pose).
 #pragma once
 
 #include <Eigen/Core>
@@ -18,6 +19,7 @@ namespace diffpills::examples {
 
 // Starts from the rollout of initial_controls, as ALTRO does.
 IpoptRun solve_with_ipopt(const CarBusProblem& problem,
-                          const std::vector<Eigen::VectorXd>& initial_controls);
+                          const std::vector<Eigen::VectorXd>& initial_controls,
+                          IpoptHessian hessian = IpoptHessian::kLimitedMemory);
 
 }  // namespace diffpills::examples

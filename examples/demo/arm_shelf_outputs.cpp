@@ -10,6 +10,7 @@
 #include <variant>
 
 #include "demo_json.hpp"
+#include "ipopt/problem_nlp.hpp"
 #include "json_io.hpp"
 #include "svg.hpp"
 
@@ -55,7 +56,7 @@ Pose compose(const Pose& body, const Pose& local) {
 
 }  // namespace
 
-ArmShelfRun solve_arm_shelf(const ArmShelfProblem& problem) {
+ArmShelfRun solve_arm_shelf(const ArmShelfProblem& problem, const DemoSettings& settings) {
   const ArmShelfScenario& s = problem.scenario();
   ArmShelfRun run;
   std::vector<Eigen::VectorXd> line{s.start};
@@ -64,17 +65,19 @@ ArmShelfRun solve_arm_shelf(const ArmShelfProblem& problem) {
   }
   run.straight_line_min_distance = arm_shelf_path_min_distance(problem, line, 1);
   const std::vector<Eigen::VectorXd> guess = problem.retreat_controls();
-  run.solve_ms = INFINITY;
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    const auto start = std::chrono::steady_clock::now();
-    run.result = trajopt::solve(problem, s.start, guess, ArmShelfProblem::settings());
-    const std::chrono::duration<double, std::milli> elapsed =
-        std::chrono::steady_clock::now() - start;
-    run.solve_ms = std::min(run.solve_ms, elapsed.count());
-  }
+  run.runs = settings.runs(true);
+  AltroRun altro = fastest_altro(run.runs, [&] {
+    return trajopt::solve(problem, s.start, guess, ArmShelfProblem::settings());
+  });
+  run.result = std::move(altro.result);
+  run.solve_ms = altro.solve_ms;
   run.min_distance = arm_shelf_path_min_distance(problem, run.result.states, 1);
   run.path_min_distance = arm_shelf_path_min_distance(problem, run.result.states, 20);
-  run.ipopt = solve_problem_with_ipopt(problem, s.start, guess);
+  if (!settings.quick) {
+    run.ipopt = fastest_ipopt(run.runs, [&](IpoptHessian hessian) {
+      return solve_problem_with_ipopt(problem, s.start, guess, hessian);
+    });
+  }
   return run;
 }
 
@@ -105,31 +108,31 @@ void write_arm_shelf_json(const ArmShelfProblem& problem, const ArmShelfRun& run
   for (const auto& [f, g] : arm.excluded_link_pairs) excluded.push_back({f, g});
   json limits = json::array();
   for (int i = 0; i < 7; ++i) limits.push_back({arm.joint_limits(i, 0), arm.joint_limits(i, 1)});
-  const json out = {{"dh",
-                     {{"a", list_of(arm.chain.a)},
-                      {"d", list_of(arm.chain.d)},
-                      {"alpha", list_of(arm.chain.alpha)}}},
-                    {"flange_d", arm.chain.flange_d},
-                    {"joint_limits", limits},
-                    {"velocity_limits", json_list(arm.velocity_limits)},
-                    {"links", links},
-                    {"excluded_link_pairs", excluded},
-                    {"shelf", app::to_json(Scene(s.shelf))},
-                    {"start", json_list(s.start)},
-                    {"goal", json_list(s.goal)},
-                    {"knots", s.knots},
-                    {"dt", s.dt},
-                    {"clearance", s.clearance},
-                    {"status", trajopt::to_string(run.result.status)},
-                    {"iterations", run.result.iterations},
-                    {"ms", run.solve_ms},
-                    {"cost", run.result.cost},
-                    {"max_violation", run.result.max_violation},
-                    {"min_distance", run.min_distance},
-                    {"path_min_distance", run.path_min_distance},
-                    {"straight_line_min_distance", run.straight_line_min_distance},
-                    {"solver", altro_summary(run.result, run.solve_ms)},
-                    {"ipopt", ipopt_summary(run.ipopt)}};
+  json out = {{"dh",
+               {{"a", list_of(arm.chain.a)},
+                {"d", list_of(arm.chain.d)},
+                {"alpha", list_of(arm.chain.alpha)}}},
+              {"flange_d", arm.chain.flange_d},
+              {"joint_limits", limits},
+              {"velocity_limits", json_list(arm.velocity_limits)},
+              {"links", links},
+              {"excluded_link_pairs", excluded},
+              {"shelf", app::to_json(Scene(s.shelf))},
+              {"start", json_list(s.start)},
+              {"goal", json_list(s.goal)},
+              {"knots", s.knots},
+              {"dt", s.dt},
+              {"clearance", s.clearance},
+              {"status", trajopt::to_string(run.result.status)},
+              {"iterations", run.result.iterations},
+              {"ms", run.solve_ms},
+              {"cost", run.result.cost},
+              {"max_violation", run.result.max_violation},
+              {"min_distance", run.min_distance},
+              {"path_min_distance", run.path_min_distance},
+              {"straight_line_min_distance", run.straight_line_min_distance},
+              {"solver", altro_summary(run.result, run.solve_ms)}};
+  add_ipopt_comparison(out, run.ipopt, run.solve_ms, run.runs);
   std::ofstream(path) << out.dump(2) << "\n";
 }
 

@@ -4,10 +4,11 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 
 #include "arm_shelf/arm_shelf.hpp"
 #include "diffpills/trajopt/altro.hpp"
-#include "ipopt/problem_nlp.hpp"
+#include "solver_runs.hpp"
 
 namespace diffpills::examples {
 
@@ -17,12 +18,13 @@ struct ArmShelfRun {
   double min_distance = 0.0;       // smallest signed distance over the checked pairs and knots
   double path_min_distance = 0.0;  // the same between knots too, 20 samples per step
   double straight_line_min_distance = 0.0;  // over the straight line's knots
-  IpoptRun ipopt;
+  int runs = 1;                             // per solver
+  std::optional<IpoptRuns> ipopt;           // the same problem from the same guess (not when quick)
 };
 
-// The fastest of three ALTRO solves (not a cold-cache outlier) and one Ipopt solve, both from the
-// retreating guess.
-ArmShelfRun solve_arm_shelf(const ArmShelfProblem& problem);
+// ALTRO and Ipopt (both Hessians) from the retreating guess, each solved settings.runs(true)
+// times (once: Ipopt's runs take up to a minute) and its fastest run kept.
+ArmShelfRun solve_arm_shelf(const ArmShelfProblem& problem, const DemoSettings& settings);
 
 // A header line "t,q1,q2,q3,q4,q5,q6,q7", then one row per knot.
 void write_arm_shelf_csv(const ArmShelfProblem& problem, const ArmShelfRun& run,

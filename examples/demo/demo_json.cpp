@@ -20,11 +20,9 @@ nlohmann::ordered_json altro_summary(const trajopt::AltroResult& result, double 
 }
 
 nlohmann::ordered_json ipopt_summary(const IpoptRun& run) {
-  return {{"status", run.status},
-          {"iterations", run.iterations},
-          {"max_violation", run.max_violation},
-          {"cost", run.cost},
-          {"solve_ms", run.solve_ms}};
+  return {
+      {"hessian", to_string(run.hessian)},  {"status", run.status}, {"iterations", run.iterations},
+      {"max_violation", run.max_violation}, {"cost", run.cost},     {"solve_ms", run.solve_ms}};
 }
 
 }  // namespace diffpills::examples

@@ -16,7 +16,8 @@ nlohmann::ordered_json json_list(const Eigen::VectorXd& v);
 // and solve_ms.
 nlohmann::ordered_json altro_summary(const trajopt::AltroResult& result, double solve_ms);
 
-// The "ipopt" block: status, iterations, max_violation, cost and solve_ms.
+// An Ipopt block: hessian ("limited-memory" or "exact"), status, iterations, max_violation, cost
+// and solve_ms.
 nlohmann::ordered_json ipopt_summary(const IpoptRun& run);
 
 }  // namespace diffpills::examples

@@ -1,8 +1,13 @@
 // `make demo`: solves the paper's car-bus problem, the quadrotor-window problem and the arm-shelf
 // problem with the ALTRO-style optimizer and writes, in the output folder (default out/),
 // car_bus.{csv,json,svg}, quadrotor_window.{csv,json,svg}, arm_shelf.{csv,json,svg} and scene.svg
-// (the paper's Fig. 1: a capsule beside a padded polygon, closest points and normal). Prints a
-// summary table.
+// (the paper's Fig. 1: a capsule beside a padded polygon, closest points and normal). Each problem
+// is cross-checked with Ipopt from the same guess, with its limited-memory and its exact Hessian,
+// every solver timed the same way (solver_runs.hpp). Prints a summary table.
+//
+// Usage: diffpills_demo [output folder] [--quick]. --quick (the tests') runs each solver once and
+// Ipopt on the car-bus problem only: the quadrotor's and the arm's Ipopt runs take minutes under
+// the sanitizers.
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
@@ -19,6 +24,7 @@
 #include "demo_scene.hpp"
 #include "json_io.hpp"
 #include "quadrotor_window_outputs.hpp"
+#include "solver_runs.hpp"
 #include "svg.hpp"
 
 namespace {
@@ -31,13 +37,15 @@ using examples::json_list;
 
 struct CarBusRun {
   trajopt::AltroResult result;
-  examples::IpoptRun ipopt;
+  examples::IpoptRuns ipopt;
   double guess_min_phi = 0.0;
   double solve_ms = 0.0;
+  int runs = 1;  // per solver
 };
 
-// The best of a few solves of each solver, so that the times are not cold-cache outliers.
-CarBusRun solve_car_bus(const examples::CarBusProblem& problem) {
+// ALTRO and Ipopt (both Hessians), each the fastest of settings.runs(false) solves.
+CarBusRun solve_car_bus(const examples::CarBusProblem& problem,
+                        const examples::DemoSettings& settings) {
   const examples::CarBusScenario& s = problem.scenario();
   const std::vector<Eigen::VectorXd> guess = problem.straight_line_controls();
   CarBusRun run;
@@ -50,18 +58,14 @@ CarBusRun solve_car_bus(const examples::CarBusProblem& problem) {
     x = next;
     run.guess_min_phi = std::min(run.guess_min_phi, examples::car_bus_phi(s, x));
   }
-  run.solve_ms = INFINITY;
-  for (int attempt = 0; attempt < 5; ++attempt) {
-    const auto start = std::chrono::steady_clock::now();
-    run.result = trajopt::solve(problem, s.x0, guess);
-    const std::chrono::duration<double, std::milli> elapsed =
-        std::chrono::steady_clock::now() - start;
-    run.solve_ms = std::min(run.solve_ms, elapsed.count());
-  }
-  for (int attempt = 0; attempt < 3; ++attempt) {  // the fastest of three, as for ALTRO above
-    examples::IpoptRun ipopt = examples::solve_with_ipopt(problem, guess);
-    if (attempt == 0 || ipopt.solve_ms < run.ipopt.solve_ms) run.ipopt = std::move(ipopt);
-  }
+  run.runs = settings.runs(false);
+  examples::AltroRun altro =
+      examples::fastest_altro(run.runs, [&] { return trajopt::solve(problem, s.x0, guess); });
+  run.result = std::move(altro.result);
+  run.solve_ms = altro.solve_ms;
+  run.ipopt = examples::fastest_ipopt(run.runs, [&](examples::IpoptHessian hessian) {
+    return examples::solve_with_ipopt(problem, guess, hessian);
+  });
   return run;
 }
 
@@ -86,17 +90,17 @@ void write_car_bus_json(const examples::CarBusProblem& problem, const CarBusRun&
   const examples::CarBusScenario& s = problem.scenario();
   json bus = app::to_json(Shape(s.bus), s.bus_pose);
   bus.erase("type");
-  const json out = {{"dt", s.dt},
-                    {"N", s.knots},
-                    {"wheelbase", s.car_model.wheelbase},
-                    {"car", {{"length", s.car.length()}, {"radius", s.car.radius()}}},
-                    {"bus", bus},
-                    {"x0", json_list(s.x0)},
-                    {"goal", json_list(s.goal)},
-                    {"control_limit", json_list(s.control_limit)},
-                    {"initial_guess_min_phi", run.guess_min_phi},
-                    {"solver", altro_summary(run.result, run.solve_ms)},
-                    {"ipopt", ipopt_summary(run.ipopt)}};
+  json out = {{"dt", s.dt},
+              {"N", s.knots},
+              {"wheelbase", s.car_model.wheelbase},
+              {"car", {{"length", s.car.length()}, {"radius", s.car.radius()}}},
+              {"bus", bus},
+              {"x0", json_list(s.x0)},
+              {"goal", json_list(s.goal)},
+              {"control_limit", json_list(s.control_limit)},
+              {"initial_guess_min_phi", run.guess_min_phi},
+              {"solver", altro_summary(run.result, run.solve_ms)}};
+  examples::add_ipopt_comparison(out, run.ipopt, run.solve_ms, run.runs);
   std::ofstream(path) << out.dump(2) << "\n";
 }
 
@@ -167,82 +171,95 @@ void write_scene_svg(const std::filesystem::path& path) {
   std::ofstream(path) << svg.str();
 }
 
-// One row of the summary table, without its Ipopt columns.
 // The quadrotor behind a thin wall (panels and body padded by 0.025 m each): the same problem
-// with phi and with the signed distance as the clearance, the fastest of three solves each.
-struct ThinWallRun {
-  trajopt::AltroResult result;
-  double solve_ms = INFINITY;
-};
-ThinWallRun solve_thin_wall(examples::Clearance clearance) {
+// with phi and with the signed distance as the clearance, ALTRO alone.
+examples::AltroRun solve_thin_wall(examples::Clearance clearance,
+                                   const examples::DemoSettings& settings) {
   examples::QuadrotorWindowScenario scenario;
   scenario.wall_radius = 0.025;
   scenario.body_radius = 0.025;
   scenario.clearance = clearance;
   scenario.build();
   const examples::QuadrotorWindowProblem problem{scenario};
-  ThinWallRun run;
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    const auto start = std::chrono::steady_clock::now();
-    run.result = trajopt::solve(problem, scenario.x0, problem.hover_controls());
-    const std::chrono::duration<double, std::milli> elapsed =
-        std::chrono::steady_clock::now() - start;
-    run.solve_ms = std::min(run.solve_ms, elapsed.count());
-  }
-  return run;
+  return examples::fastest_altro(settings.runs(false), [&] {
+    return trajopt::solve(problem, scenario.x0, problem.hover_controls());
+  });
 }
 
-void print_row(const std::string& name, const trajopt::AltroResult& result, double solve_ms) {
+// One row of the summary table: ALTRO's run, then each Ipopt run's time and cost, and ALTRO's
+// speed-up over the faster one ("-" without Ipopt).
+void print_row(const std::string& name, const trajopt::AltroResult& result, double solve_ms,
+               const std::optional<examples::IpoptRuns>& ipopt) {
   std::cout << std::left << std::setw(18) << name << std::right << std::setw(8)
             << (result.status == trajopt::AltroStatus::kSolved ? "solved" : "FAILED")
             << std::setw(12) << result.iterations << std::setw(15) << std::setprecision(3)
             << result.max_violation << std::setw(12) << std::setprecision(6) << result.cost
             << std::setw(10) << std::setprecision(3) << solve_ms;
+  if (!ipopt) {
+    std::cout << std::setw(14) << "-" << std::setw(12) << "-" << std::setw(14) << "-"
+              << std::setw(12) << "-" << std::setw(10) << "-\n";
+    return;
+  }
+  for (const examples::IpoptRun* run : {&ipopt->limited_memory, &ipopt->exact}) {
+    std::cout << std::setw(14) << std::setprecision(4) << run->solve_ms << std::setw(12)
+              << std::setprecision(6) << run->cost;
+  }
+  std::cout << std::setw(9) << std::setprecision(3) << ipopt->faster().solve_ms / solve_ms << "x\n";
 }
 
 int run(int argc, char** argv) {
-  const std::filesystem::path out_dir = argc > 1 ? argv[1] : "out";
+  std::filesystem::path out_dir = "out";
+  examples::DemoSettings settings;
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (argument == "--quick") {
+      settings.quick = true;
+    } else if (argument.rfind("--", 0) == 0) {
+      std::cerr << "usage: diffpills_demo [output folder] [--quick]\n";
+      return 2;
+    } else {
+      out_dir = argument;
+    }
+  }
   std::filesystem::create_directories(out_dir);
 
   const examples::CarBusProblem car_bus{examples::CarBusScenario{}};
-  const CarBusRun run = solve_car_bus(car_bus);
+  const CarBusRun run = solve_car_bus(car_bus, settings);
   write_car_bus_csv(car_bus, run, out_dir / "car_bus.csv");
   write_car_bus_json(car_bus, run, out_dir / "car_bus.json");
   write_car_bus_svg(car_bus, run, out_dir / "car_bus.svg");
   write_scene_svg(out_dir / "scene.svg");
 
   const examples::QuadrotorWindowProblem quadrotor{examples::QuadrotorWindowScenario{}};
-  const examples::QuadrotorWindowRun flight = examples::solve_quadrotor_window(quadrotor);
+  const examples::QuadrotorWindowRun flight = examples::solve_quadrotor_window(quadrotor, settings);
   examples::write_quadrotor_window_csv(quadrotor, flight, out_dir / "quadrotor_window.csv");
   examples::write_quadrotor_window_json(quadrotor, flight, out_dir / "quadrotor_window.json");
   examples::write_quadrotor_window_svg(quadrotor, flight, out_dir / "quadrotor_window.svg");
 
   const examples::ArmShelfProblem arm{examples::ArmShelfScenario{}};
-  const examples::ArmShelfRun reach = examples::solve_arm_shelf(arm);
+  const examples::ArmShelfRun reach = examples::solve_arm_shelf(arm, settings);
   examples::write_arm_shelf_csv(arm, reach, out_dir / "arm_shelf.csv");
   examples::write_arm_shelf_json(arm, reach, out_dir / "arm_shelf.json");
   examples::write_arm_shelf_svg(arm, reach, out_dir / "arm_shelf.svg");
 
   std::cout << std::left << std::setw(18) << "problem" << std::right << std::setw(8) << "status"
             << std::setw(12) << "iterations" << std::setw(15) << "max violation" << std::setw(12)
-            << "cost" << std::setw(10) << "ms" << std::setw(12) << "Ipopt ms" << std::setw(12)
-            << "Ipopt cost"
+            << "cost" << std::setw(10) << "ms" << std::setw(14) << "Ipopt L-M ms" << std::setw(12)
+            << "cost" << std::setw(14) << "Ipopt exact" << std::setw(12) << "cost" << std::setw(10)
+            << "speed-up"
             << "\n";
-  print_row("car_bus", run.result, run.solve_ms);
-  std::cout << std::setw(12) << std::setprecision(4) << run.ipopt.solve_ms << std::setw(12)
-            << std::setprecision(6) << run.ipopt.cost << "\n";
-  print_row("quadrotor_window", flight.result, flight.solve_ms);
-  std::cout << std::setw(12) << "-" << std::setw(12) << "-"
-            << "\n";
-  print_row("arm_shelf", reach.result, reach.solve_ms);
-  std::cout << std::setw(12) << std::setprecision(4) << reach.ipopt.solve_ms << std::setw(12)
-            << std::setprecision(6) << reach.ipopt.cost << "\n";
-  const ThinWallRun thin_phi = solve_thin_wall(examples::Clearance::kProximity);
-  const ThinWallRun thin_distance = solve_thin_wall(examples::Clearance::kSignedDistance);
-  print_row("thin_wall (phi)", thin_phi.result, thin_phi.solve_ms);
-  std::cout << "\n";
-  print_row("thin_wall (sd)", thin_distance.result, thin_distance.solve_ms);
-  std::cout << "\n\n";
+  print_row("car_bus", run.result, run.solve_ms, run.ipopt);
+  print_row("quadrotor_window", flight.result, flight.solve_ms, flight.ipopt);
+  print_row("arm_shelf", reach.result, reach.solve_ms, reach.ipopt);
+  const examples::AltroRun thin_phi = solve_thin_wall(examples::Clearance::kProximity, settings);
+  const examples::AltroRun thin_distance =
+      solve_thin_wall(examples::Clearance::kSignedDistance, settings);
+  print_row("thin_wall (phi)", thin_phi.result, thin_phi.solve_ms, std::nullopt);
+  print_row("thin_wall (sd)", thin_distance.result, thin_distance.solve_ms, std::nullopt);
+  std::cout << "\nALTRO and Ipopt from the same guess; the fastest run of " << run.runs
+            << " per solver (the arm: " << reach.runs
+            << "); Ipopt with its limited-memory (L-M) and its exact Hessian; speed-up: the "
+               "faster Ipopt's time over ALTRO's\n";
   std::cout << std::setprecision(3)
             << "car_bus: straight-line initial guess collides, smallest phi " << run.guess_min_phi
             << "\nquadrotor_window: the level body slid straight through has "

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "demo_json.hpp"
+#include "ipopt/problem_nlp.hpp"
 #include "json_io.hpp"
 #include "svg.hpp"
 
@@ -35,17 +36,20 @@ double level_straight_line_min_phi(const QuadrotorWindowScenario& s) {
 
 }  // namespace
 
-QuadrotorWindowRun solve_quadrotor_window(const QuadrotorWindowProblem& problem) {
+QuadrotorWindowRun solve_quadrotor_window(const QuadrotorWindowProblem& problem,
+                                          const DemoSettings& settings) {
   const QuadrotorWindowScenario& s = problem.scenario();
   QuadrotorWindowRun run;
   run.level_straight_line_min_phi = level_straight_line_min_phi(s);
-  run.solve_ms = INFINITY;
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    const auto start = std::chrono::steady_clock::now();
-    run.result = trajopt::solve(problem, s.x0, problem.hover_controls());
-    const std::chrono::duration<double, std::milli> elapsed =
-        std::chrono::steady_clock::now() - start;
-    run.solve_ms = std::min(run.solve_ms, elapsed.count());
+  run.runs = settings.runs(false);
+  const std::vector<Eigen::VectorXd> guess = problem.hover_controls();
+  AltroRun altro = fastest_altro(run.runs, [&] { return trajopt::solve(problem, s.x0, guess); });
+  run.result = std::move(altro.result);
+  run.solve_ms = altro.solve_ms;
+  if (!settings.quick) {
+    run.ipopt = fastest_ipopt(run.runs, [&](IpoptHessian hessian) {
+      return solve_problem_with_ipopt(problem, s.x0, guess, hessian);
+    });
   }
   run.min_phi = INFINITY;
   for (const Eigen::VectorXd& x : run.result.states) {
@@ -82,30 +86,31 @@ void write_quadrotor_window_json(const QuadrotorWindowProblem& problem,
     wall.push_back(app::to_json(Shape(panel.shape), panel.pose));
   for (const PosedCapsule& pole : s.poles)
     poles.push_back(app::to_json(Shape(pole.shape), pole.pose));
-  const json out = {{"dt", s.dt},
-                    {"N", s.knots},
-                    {"quadrotor",
-                     {{"mass", s.model.mass},
-                      {"inertia", json_list(s.model.inertia)},
-                      {"arm", s.model.arm},
-                      {"torque_per_thrust", s.model.torque_per_thrust},
-                      {"gravity", s.model.gravity},
-                      {"thrust_max", s.thrust_max},
-                      {"body", body}}},
-                    {"window",
-                     {{"centre", json_list(s.window_centre)},
-                      {"width", s.window_width},
-                      {"height", s.window_height},
-                      {"tilt", s.window_tilt}}},
-                    {"wall", wall},
-                    {"poles", poles},
-                    {"x0", json_list(s.x0)},
-                    {"goal", json_list(s.goal)},
-                    {"initial_guess", "hover thrust at every step"},
-                    {"level_straight_line_min_phi", run.level_straight_line_min_phi},
-                    {"min_phi", run.min_phi},
-                    {"largest_tilt_deg", run.largest_tilt_deg},
-                    {"solver", altro_summary(run.result, run.solve_ms)}};
+  json out = {{"dt", s.dt},
+              {"N", s.knots},
+              {"quadrotor",
+               {{"mass", s.model.mass},
+                {"inertia", json_list(s.model.inertia)},
+                {"arm", s.model.arm},
+                {"torque_per_thrust", s.model.torque_per_thrust},
+                {"gravity", s.model.gravity},
+                {"thrust_max", s.thrust_max},
+                {"body", body}}},
+              {"window",
+               {{"centre", json_list(s.window_centre)},
+                {"width", s.window_width},
+                {"height", s.window_height},
+                {"tilt", s.window_tilt}}},
+              {"wall", wall},
+              {"poles", poles},
+              {"x0", json_list(s.x0)},
+              {"goal", json_list(s.goal)},
+              {"initial_guess", "hover thrust at every step"},
+              {"level_straight_line_min_phi", run.level_straight_line_min_phi},
+              {"min_phi", run.min_phi},
+              {"largest_tilt_deg", run.largest_tilt_deg},
+              {"solver", altro_summary(run.result, run.solve_ms)}};
+  add_ipopt_comparison(out, run.ipopt, run.solve_ms, run.runs);
   std::ofstream(path) << out.dump(2) << "\n";
 }
 

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 
 #include "diffpills/trajopt/altro.hpp"
 #include "quadrotor_window/quadrotor_window.hpp"
+#include "solver_runs.hpp"
 
 namespace diffpills::examples {
 
@@ -15,12 +17,15 @@ struct QuadrotorWindowRun {
   // The level body slid along the straight line from start to goal (no dynamics): it cannot pass
   // the window, which this negative number shows.
   double level_straight_line_min_phi = 0.0;
-  double min_phi = 0.0;           // over the solution's knots and obstacles
-  double largest_tilt_deg = 0.0;  // angle between body z and world z, over the knots
+  double min_phi = 0.0;            // over the solution's knots and obstacles
+  double largest_tilt_deg = 0.0;   // angle between body z and world z, over the knots
+  int runs = 1;                    // per solver
+  std::optional<IpoptRuns> ipopt;  // the same problem from the same guess (not when quick)
 };
 
-// The best time of a few solves from hover, so that the time is not a cold-cache outlier.
-QuadrotorWindowRun solve_quadrotor_window(const QuadrotorWindowProblem& problem);
+// ALTRO and Ipopt (both Hessians) from hover, each the fastest of settings.runs(false) solves.
+QuadrotorWindowRun solve_quadrotor_window(const QuadrotorWindowProblem& problem,
+                                          const DemoSettings& settings);
 
 // CSV header: k,t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,u1,u2,u3,u4 (the last row's controls
 // empty).

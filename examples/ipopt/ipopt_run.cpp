@@ -20,9 +20,14 @@ std::vector<Eigen::VectorXd> rollout(const trajopt::Problem& problem, const Eige
   return states;
 }
 
-IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& result) {
+const char* to_string(IpoptHessian hessian) {
+  return hessian == IpoptHessian::kExact ? "exact" : "limited-memory";
+}
+
+IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& result,
+                     IpoptHessian hessian) {
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
+  app->Options()->SetStringValue("hessian_approximation", to_string(hessian));
   app->Options()->SetNumericValue("tol", 1e-8);
   app->Options()->SetNumericValue("constr_viol_tol", 1e-6);
   app->Options()->SetIntegerValue("max_iter", 3000);
@@ -38,6 +43,7 @@ IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& re
     solve_ms = elapsed.count();
   }
   IpoptRun run = result;
+  run.hessian = hessian;
   run.solve_ms = solve_ms;
   run.status =
       status == Ipopt::Solve_Succeeded ? "solved" : "failed (" + std::to_string(status) + ")";

@@ -10,7 +10,14 @@
 
 namespace diffpills::examples {
 
+// How Ipopt gets the Hessian of the Lagrangian: its limited-memory quasi-Newton approximation
+// (L-BFGS, from first derivatives alone), or exact, from the problem's second derivatives
+// (problem.hpp's dynamics_hessian and constraint_hessian and the costs' exact Hessians).
+enum class IpoptHessian { kLimitedMemory, kExact };
+const char* to_string(IpoptHessian hessian);  // "limited-memory", "exact"
+
 struct IpoptRun {
+  IpoptHessian hessian = IpoptHessian::kLimitedMemory;
   bool solved = false;
   std::string status;
   int iterations = 0;

@@ -3,7 +3,9 @@
 #include <IpTNLP.hpp>
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
+#include "knot_hessian.hpp"
 #include "timed_solve.hpp"
 
 namespace diffpills::examples {
@@ -24,7 +26,8 @@ class ProblemNlp : public Ipopt::TNLP {
         knots_(problem.knots()),
         x0_(std::move(x0)),
         guess_states_(std::move(guess_states)),
-        guess_controls_(std::move(guess_controls)) {
+        guess_controls_(std::move(guess_controls)),
+        hessian_(n_, m_, knots_) {
     // Each knot's rows (fixed between calls, problem.hpp), from the guess.
     Index offset = n_ * (knots_ - 1);
     for (int k = 0; k < knots_; ++k) {
@@ -47,7 +50,7 @@ class ProblemNlp : public Ipopt::TNLP {
     nnz_jac = (knots_ - 1) * (n_ + n_ * n_ + n_ * m_);
     for (int k = 0; k < knots_; ++k)
       nnz_jac += rows_[static_cast<std::size_t>(k)] * (n_ + (k + 1 < knots_ ? m_ : 0));
-    nnz_hess = 0;
+    nnz_hess = hessian_.nonzeros();
     style = C_STYLE;
     return true;
   }
@@ -147,6 +150,34 @@ class ProblemNlp : public Ipopt::TNLP {
     return true;
   }
 
+  // The Lagrangian obj_factor l(z) + lambda' g(z): per knot, the costs' Hessian, the defect's
+  // -f(x_k, u_k) weighted by its multipliers, and the knot's constraints weighted by theirs.
+  bool eval_h(Index, const Number* z, bool, Number obj_factor, Index, const Number* lambda, bool,
+              Index, Index* rows, Index* cols, Number* values) override {
+    if (values == nullptr) {
+      hessian_.structure(rows, cols);
+      return true;
+    }
+    std::fill(values, values + hessian_.nonzeros(), 0.0);
+    for (int k = 0; k < knots_; ++k) {
+      const auto s = static_cast<std::size_t>(k);
+      const Eigen::VectorXd x = state(z, k), u = control_or_empty(k, z);
+      const bool last = k + 1 == knots_;
+      Eigen::MatrixXd block =
+          cost_block(last ? problem_.terminal_cost(x) : problem_.stage_cost(k, x, u), obj_factor);
+      if (!last) {
+        const Eigen::Map<const Eigen::VectorXd> defect(lambda + std::ptrdiff_t{n_} * k, n_);
+        block += problem_.dynamics_hessian(x, u, -defect);
+      }
+      if (rows_[s] > 0) {
+        block += problem_.constraint_hessian(
+            k, x, u, Eigen::Map<const Eigen::VectorXd>(lambda + row_start_[s], rows_[s]));
+      }
+      hessian_.add(k, block, values);
+    }
+    return true;
+  }
+
   void finalize_solution(Ipopt::SolverReturn status, Index, const Number* z, const Number*,
                          const Number*, Index, const Number* g, const Number*, Number objective,
                          const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
@@ -222,15 +253,20 @@ class ProblemNlp : public Ipopt::TNLP {
   std::vector<Index> row_start_, rows_;
   std::vector<int> equalities_;
   Index constraints_ = 0;
+  KnotHessian hessian_;
 };
 
 }  // namespace
 
 IpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
-                                  const std::vector<Eigen::VectorXd>& initial_controls) {
+                                  const std::vector<Eigen::VectorXd>& initial_controls,
+                                  IpoptHessian hessian) {
+  if (hessian == IpoptHessian::kExact && !problem.has_second_derivatives()) {
+    throw std::invalid_argument("hessian: the problem supplies no second derivatives");
+  }
   const std::vector<Eigen::VectorXd> states = rollout(problem, x0, initial_controls);
   Ipopt::SmartPtr<ProblemNlp> nlp = new ProblemNlp(problem, x0, states, initial_controls);
-  return solve_timed(nlp, nlp->run);
+  return solve_timed(nlp, nlp->run, hessian);
 }
 
 }  // namespace diffpills::examples

@@ -4,8 +4,11 @@
 //   minimize    sum_k l_k(x_k, u_k) + l_N(x_{N-1})
 //   subject to  x_{k+1} - f(x_k, u_k) = 0,  e_k(x_k, u_k) = 0,  c_k(x_k, u_k) <= 0,
 //               x_0 = the given initial state (variable bounds)
-// with the problem's exact first derivatives (dense per knot) and Ipopt's limited-memory Hessian
-// approximation, started from the rollout of the initial controls, as ALTRO is.
+// with the problem's exact first derivatives (dense per knot) and either Ipopt's limited-memory
+// Hessian approximation or the exact Hessian of the Lagrangian from the problem's second
+// derivatives (block diagonal by knot: knot_hessian.hpp), started from the rollout of the initial
+// controls, as ALTRO is. kExact needs problem.has_second_derivatives() (else
+// std::invalid_argument).
 #pragma once
 
 #include <Eigen/Core>
@@ -17,6 +20,7 @@
 namespace diffpills::examples {
 
 IpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
-                                  const std::vector<Eigen::VectorXd>& initial_controls);
+                                  const std::vector<Eigen::VectorXd>& initial_controls,
+                                  IpoptHessian hessian = IpoptHessian::kLimitedMemory);
 
 }  // namespace diffpills::examples

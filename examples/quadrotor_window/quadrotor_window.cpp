@@ -200,6 +200,35 @@ trajopt::KnotConstraints QuadrotorWindowProblem::evaluate_constraints(int k,
   return c;
 }
 
+Eigen::MatrixXd QuadrotorWindowProblem::dynamics_hessian(const Eigen::VectorXd& x,
+                                                         const Eigen::VectorXd& u,
+                                                         const Eigen::VectorXd& lambda) const {
+  return scenario_.model.step_hessian(scenario_.dt, x, u, lambda);
+}
+
+// The obstacle rows are the only nonlinear ones: each adds -mu times its measure's Hessian with
+// respect to the body's pose, which is the state's first seven entries as they are.
+Eigen::MatrixXd QuadrotorWindowProblem::constraint_hessian(int k, const Eigen::VectorXd& x,
+                                                           const Eigen::VectorXd& u,
+                                                           const Eigen::VectorXd& mu) const {
+  const bool last = k == scenario_.knots - 1;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(13 + u.size(), 13 + u.size());
+  const Pose pose = quadrotor_pose(x);
+  int row = last ? 3 : 0;
+  const auto add = [&](const auto& obstacle) {
+    const double weight = mu(row++);
+    if (weight == 0.0) return;
+    const Eigen::Matrix<double, 14, 14> measure =
+        scenario_.clearance == Clearance::kProximity
+            ? proximity_hessian(scenario_.body, pose, obstacle.shape, obstacle.pose).hessian
+            : signed_distance_hessian(scenario_.body, pose, obstacle.shape, obstacle.pose).hessian;
+    H.topLeftCorner<7, 7>() -= weight * measure.topLeftCorner<7, 7>();
+  };
+  for (const PosedPolygon& panel : scenario_.wall) add(panel);
+  for (const PosedCapsule& p : scenario_.poles) add(p);
+  return H;
+}
+
 std::vector<Eigen::VectorXd> QuadrotorWindowProblem::hover_controls() const {
   return std::vector<Eigen::VectorXd>(scenario_.knots - 1, hover_);
 }

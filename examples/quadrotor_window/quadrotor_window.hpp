@@ -61,7 +61,8 @@ double quadrotor_min_phi(const QuadrotorWindowScenario& scenario, const Eigen::V
 // Costs 1/2 (x - goal)'Q(x - goal) + 1/2 (u - hover)'R(u - hover) per knot and
 // 1/2 (x - goal)'Qf(x - goal) at the end; constraints -clearance <= 0 (phi or the signed
 // distance) for every obstacle at every knot,
-// 0 <= u <= thrust_max, and the final position equal to the goal's.
+// 0 <= u <= thrust_max, and the final position equal to the goal's; with exact second derivatives
+// (the costs are quadratic).
 class QuadrotorWindowProblem : public trajopt::Problem {
  public:
   explicit QuadrotorWindowProblem(QuadrotorWindowScenario scenario);
@@ -78,6 +79,11 @@ class QuadrotorWindowProblem : public trajopt::Problem {
                                        const Eigen::VectorXd& u) const override;
   trajopt::KnotConstraints constraint_values(int k, const Eigen::VectorXd& x,
                                              const Eigen::VectorXd& u) const override;
+  bool has_second_derivatives() const override { return true; }
+  Eigen::MatrixXd dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                   const Eigen::VectorXd& lambda) const override;
+  Eigen::MatrixXd constraint_hessian(int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                     const Eigen::VectorXd& mu) const override;
 
   const QuadrotorWindowScenario& scenario() const { return scenario_; }
   int obstacle_count() const;

@@ -20,6 +20,16 @@ KnotConstraints Problem::constraints(int /*k*/, const Eigen::VectorXd& x,
   return none;
 }
 
+Eigen::MatrixXd Problem::dynamics_hessian(const Eigen::VectorXd&, const Eigen::VectorXd&,
+                                          const Eigen::VectorXd&) const {
+  throw std::logic_error("dynamics_hessian: this problem supplies no second derivatives");
+}
+
+Eigen::MatrixXd Problem::constraint_hessian(int, const Eigen::VectorXd&, const Eigen::VectorXd&,
+                                            const Eigen::VectorXd&) const {
+  throw std::logic_error("constraint_hessian: this problem supplies no second derivatives");
+}
+
 const char* to_string(AltroStatus status) {
   switch (status) {
     case AltroStatus::kSolved:

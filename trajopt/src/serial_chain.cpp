@@ -34,7 +34,8 @@ ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::VectorXd& 
   ChainFrames out;
   out.origin.assign(static_cast<std::size_t>(n) + 2, Eigen::Vector3d::Zero());
   out.attitude.assign(static_cast<std::size_t>(n) + 2, Eigen::Vector4d(1, 0, 0, 0));
-  std::vector<Eigen::Vector3d> axis(static_cast<std::size_t>(n) + 1, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d>& axis = out.axis;
+  axis.assign(static_cast<std::size_t>(n) + 1, Eigen::Vector3d::Zero());
   for (int i = 1; i <= n + 1; ++i) {
     const auto f = static_cast<std::size_t>(i);
     const Eigen::Matrix3d previous = rotation_matrix(out.attitude[f - 1]);
@@ -62,6 +63,33 @@ ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::VectorXd& 
           z.cross(out.origin[frame] - out.origin[static_cast<std::size_t>(j)]);
       out.d_attitude[frame].col(j - 1) =
           0.5 * product(Eigen::Vector4d(0.0, z.x(), z.y(), z.z()), out.attitude[frame]);
+    }
+  }
+  return out;
+}
+
+AttachedPoseDerivatives attached_pose_derivatives(const ChainFrames& frames, int frame,
+                                                  const Eigen::Vector3d& position,
+                                                  const Eigen::Vector4d& attitude,
+                                                  const Eigen::Matrix<double, 7, 1>& gradient) {
+  const int n = static_cast<int>(frames.axis.size()) - 1;
+  const auto pure = [](const Eigen::Vector3d& v) {
+    return Eigen::Vector4d(0.0, v.x(), v.y(), v.z());
+  };
+  AttachedPoseDerivatives out;
+  out.jacobian = Eigen::Matrix<double, 7, Eigen::Dynamic>::Zero(7, n);
+  out.curvature = Eigen::MatrixXd::Zero(n, n);
+  const int moving = std::min(frame, n);  // joints 1 .. moving turn the frame
+  for (int j = 1; j <= moving; ++j) {
+    const Eigen::Vector3d& z_j = frames.axis[static_cast<std::size_t>(j)];
+    const Eigen::Vector3d lever = position - frames.origin[static_cast<std::size_t>(j)];
+    const Eigen::Vector4d turned = product(pure(z_j), attitude);
+    out.jacobian.col(j - 1) << z_j.cross(lever), 0.5 * turned;
+    for (int i = 1; i <= j; ++i) {
+      const Eigen::Vector3d& z_i = frames.axis[static_cast<std::size_t>(i)];
+      const double value = gradient.head<3>().dot(z_i.cross(z_j.cross(lever))) +
+                           0.25 * gradient.tail<4>().dot(product(pure(z_i), turned));
+      out.curvature(i - 1, j - 1) = out.curvature(j - 1, i - 1) = value;
     }
   }
   return out;

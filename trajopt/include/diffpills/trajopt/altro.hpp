@@ -61,7 +61,7 @@ struct AltroResult {
   double max_violation = 0.0;  // largest equality |e|, positive inequality c or dynamics defect
   int iterations = 0;          // iLQR iterations, over all outer iterations
   int outer_iterations = 0;
-  int polish_iterations = 0;   // accepted projected-Newton steps
+  int polish_iterations = 0;  // accepted projected-Newton steps
 };
 
 // Solves from x0 with the controls as the initial guess (N - 1 of them; the states follow by

@@ -22,6 +22,13 @@ struct Car {
   // One RK4 step of length h with its exact Jacobians (rk4.hpp).
   void step(double h, const State& x, const Control& u, State& next, Eigen::Matrix<double, 5, 5>& A,
             Eigen::Matrix<double, 5, 2>& B) const;
+
+  // The Hessian of a' F(x, u) with respect to [x; u] (7 x 7).
+  Eigen::Matrix<double, 7, 7> weighted_hessian(const State& x, const Control& u,
+                                               const State& a) const;
+  // The Hessian of lambda' step(h, x, u) with respect to [x; u] (rk4.hpp's rk4_hessian).
+  Eigen::Matrix<double, 7, 7> step_hessian(double h, const State& x, const Control& u,
+                                           const State& lambda) const;
 };
 
 }  // namespace diffpills::trajopt

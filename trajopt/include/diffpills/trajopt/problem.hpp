@@ -6,7 +6,10 @@
 //
 // with N knots, states x in R^n and controls u in R^m. A problem supplies its dynamics, costs and
 // constraints with their first derivatives (and the costs' second derivatives); the solver never
-// differentiates numerically. Implementations must be pure: the same inputs give the same outputs.
+// differentiates numerically. A problem may also supply the second derivatives of its dynamics and
+// constraints, for solvers that use the exact Hessian of the Lagrangian (the examples' Ipopt
+// cross-check); ALTRO does not use them. Implementations must be pure: the same inputs give the
+// same outputs.
 #pragma once
 
 #include <Eigen/Core>
@@ -67,6 +70,19 @@ class Problem {
                                             const Eigen::VectorXd& u) const {
     return constraints(k, x, u);
   }
+
+  // Second derivatives. A problem that returns true here implements the two functions below, and
+  // its CostExpansion Hessians are exact (not Gauss-Newton); the defaults have none and throw
+  // std::logic_error.
+  virtual bool has_second_derivatives() const { return false; }
+  // The Hessian of lambda' f(x, u) with respect to [x; u], (n + m) x (n + m), for lambda in R^n.
+  virtual Eigen::MatrixXd dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+                                           const Eigen::VectorXd& lambda) const;
+  // The Hessian of mu' [e_k; c_k](x, u) with respect to [x; u] (x alone at the last knot), for one
+  // multiplier per row of constraints(k, x, u).
+  virtual Eigen::MatrixXd constraint_hessian(int k, const Eigen::VectorXd& x,
+                                             const Eigen::VectorXd& u,
+                                             const Eigen::VectorXd& mu) const;
 };
 
 }  // namespace diffpills::trajopt

@@ -37,6 +37,12 @@ struct Quadrotor {
   // One RK4 step of length h, then q <- q / |q|, with the exact Jacobians of both.
   void step(double h, const State& x, const Control& u, State& next, StateMatrix& A,
             ControlMatrix& B) const;
+
+  using Hessian = Eigen::Matrix<double, 17, 17>;
+  // The Hessian of a' F(x, u) with respect to [x; u].
+  Hessian weighted_hessian(const State& x, const Control& u, const State& a) const;
+  // The Hessian of lambda' step(h, x, u) with respect to [x; u], the renormalization included.
+  Hessian step_hessian(double h, const State& x, const Control& u, const State& lambda) const;
 };
 
 }  // namespace diffpills::trajopt

@@ -16,7 +16,16 @@
 //     d o_f / d q_j = z_j x (o_f - o_j),      d q_f / d q_j = 1/2 [0, z_j] (x) q_f
 //
 // (a world-frame rotation of rate z_j), and zero for f < j. These are exact; tests compare them
-// with central differences and the poses with the 4x4 products written out separately.
+// with central differences and the poses with the 4x4 products written out separately. The same
+// holds for any point p and attitude q_p fixed in frame f (a shape posed in it).
+//
+// Second derivatives (attached_pose_curvature). For i <= j <= f, joint i turns z_j, p and o_j
+// alike (z_j by z_i x z_j, p - o_j by z_i x (p - o_j)), and joint j leaves z_j and o_j where
+// they are, so with the Jacobi identity
+//     d2 p / dq_i dq_j = z_i x (z_j x (p - o_j)),    d2 q_p / dq_i dq_j = 1/4 [0, z_i] (x) [0, z_j]
+//     (x) q_p
+// (the second: 1/2 [0, z_i x z_j] (x) q_p + 1/4 [0, z_j] (x) [0, z_i] (x) q_p, and
+// [0, a] (x) [0, b] = [-a.b, a x b]).
 #pragma once
 
 #include <Eigen/Core>
@@ -35,6 +44,7 @@ struct SerialChain {
 struct ChainFrames {
   std::vector<Eigen::Vector3d> origin;
   std::vector<Eigen::Vector4d> attitude;  // unit quaternions [w x y z], body to world
+  std::vector<Eigen::Vector3d> axis;      // axis[j] = z_j for joints j = 1 .. n (axis[0] unused)
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> d_origin;
   std::vector<Eigen::Matrix<double, 4, Eigen::Dynamic>> d_attitude;
 };
@@ -42,5 +52,17 @@ struct ChainFrames {
 // Throws std::invalid_argument if the parameter lists differ in length or q does not match them.
 ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::VectorXd& q,
                                bool derivatives = true);
+
+// For a pose (p, q_p) fixed in frame f (frames from forward_kinematics at q, 0 <= f <= n + 1):
+// its Jacobian with respect to q (7 x n, rows [p; q_p]), and sum_k gradient_k d2 pose_k / dq2
+// (n x n), the term a chain rule through the pose adds to J' H J.
+struct AttachedPoseDerivatives {
+  Eigen::Matrix<double, 7, Eigen::Dynamic> jacobian;
+  Eigen::MatrixXd curvature;
+};
+AttachedPoseDerivatives attached_pose_derivatives(const ChainFrames& frames, int frame,
+                                                  const Eigen::Vector3d& position,
+                                                  const Eigen::Vector4d& attitude,
+                                                  const Eigen::Matrix<double, 7, 1>& gradient);
 
 }  // namespace diffpills::trajopt

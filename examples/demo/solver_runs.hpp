@@ -1,0 +1,47 @@
+// How the demo times its solvers, every one of a problem the same way: the fastest of the same
+// number of runs (not a cold-cache outlier, and no solver gets more tries than another), ALTRO
+// timed around trajopt::solve, Ipopt around its solve alone (timed_solve.hpp); Ipopt with both of
+// its Hessians (limited-memory and exact), and ALTRO's speed-up over the faster of the two.
+#pragma once
+
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "diffpills/trajopt/altro.hpp"
+#include "ipopt/ipopt_run.hpp"
+
+namespace diffpills::examples {
+
+// What `diffpills_demo` runs: `repetitions` of each solver per problem (car-bus and quadrotor;
+// the arm's runs take seconds to a minute for Ipopt, so it runs each solver once), and Ipopt on
+// the quadrotor and the arm too unless `quick` (the tests' setting: one run each, Ipopt on the
+// car-bus only).
+struct DemoSettings {
+  int repetitions = 3;
+  bool quick = false;
+  int runs(bool slow) const { return quick || slow ? 1 : repetitions; }
+};
+
+struct AltroRun {
+  trajopt::AltroResult result;
+  double solve_ms = 0.0;
+};
+AltroRun fastest_altro(int runs, const std::function<trajopt::AltroResult()>& solve);
+
+struct IpoptRuns {
+  IpoptRun limited_memory, exact;
+  const IpoptRun& faster() const {
+    return exact.solve_ms < limited_memory.solve_ms ? exact : limited_memory;
+  }
+};
+// solve(hessian) runs Ipopt once with that Hessian.
+IpoptRuns fastest_ipopt(int runs, const std::function<IpoptRun(IpoptHessian)>& solve);
+
+// The "ipopt" (limited-memory) and "ipopt_exact" blocks (demo_json.hpp's ipopt_summary), and
+// "altro_speedup": {"over": the faster Ipopt's Hessian, "ratio": its solve_ms over ALTRO's,
+// "runs": runs per solver}; nothing without Ipopt runs.
+void add_ipopt_comparison(nlohmann::ordered_json& out, const std::optional<IpoptRuns>& ipopt,
+                          double altro_ms, int runs);
+
+}  // namespace diffpills::examples
