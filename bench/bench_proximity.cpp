@@ -450,7 +450,8 @@ void ArmShelf_Ipopt(benchmark::State& state) {
         examples::solve_problem_with_ipopt(problem, problem.scenario().start, guess, hessian).cost);
   }
 }
-// Argument 0: Ipopt's limited-memory Hessian, 1: exact (examples::IpoptHessian).
+// Argument exact:0: Ipopt's limited-memory Hessian, exact:1: the exact one
+// (examples::IpoptHessian).
 constexpr auto kLimitedMemory = static_cast<std::int64_t>(examples::IpoptHessian::kLimitedMemory);
 constexpr auto kExact = static_cast<std::int64_t>(examples::IpoptHessian::kExact);
 BENCHMARK(CarBus_Altro)->Unit(benchmark::kMillisecond)->Iterations(5);
@@ -461,6 +462,7 @@ BENCHMARK(CarBus_Ipopt)
     ->Iterations(5);
 BENCHMARK(QuadrotorWindow_Altro)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(QuadrotorWindow_Ipopt)
+    ->ArgName("exact")
     ->Arg(kLimitedMemory)
     ->Arg(kExact)
     ->Unit(benchmark::kMillisecond)

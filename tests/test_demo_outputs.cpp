@@ -6,6 +6,7 @@
 // and the Ipopt comparison's blocks. The demo runs with --quick (each solver once, Ipopt on the
 // car-bus problem only: the other Ipopt runs take minutes under the sanitizers).
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -299,9 +300,24 @@ TEST(DemoOutputs, IpoptComparison) {
   EXPECT_EQ(car_bus["altro_speedup"]["over"], faster_name);
   EXPECT_DOUBLE_EQ(car_bus["altro_speedup"]["ratio"].get<double>(), faster / altro_ms);
   EXPECT_EQ(car_bus["altro_speedup"]["runs"], 1);
+  EXPECT_EQ(car_bus["altro_speedup"]["same_minimum"], true);  // the costs agree (above)
   for (const char* quick_only : {"quadrotor_window.json", "arm_shelf.json"}) {
     EXPECT_FALSE(nlohmann::json::parse(read(out / quick_only)).contains("ipopt")) << quick_only;
   }
+}
+
+// The demo's command line: --help, a stray or second argument, and a folder it cannot write
+// (an existing one: /proc) end with the documented statuses, not a silent success.
+TEST(DemoOutputs, CommandLine) {
+  const auto status = [](const std::string& arguments) {
+    const int raw = std::system((demo_program + " " + arguments + " > /dev/null 2>&1").c_str());
+    return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  };
+  EXPECT_EQ(status("--help"), 0);
+  EXPECT_EQ(status("--bogus"), 2);
+  EXPECT_EQ(status("-q"), 2);
+  EXPECT_EQ(status("one two --quick"), 2);
+  EXPECT_EQ(status("/proc --quick"), 1);
 }
 
 }  // namespace

@@ -6,10 +6,14 @@
 // the arm's query margin inside the step) detected by two step sizes and skipped.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <random>
+#include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "arm_shelf/arm_shelf.hpp"
 #include "car_bus/car_bus.hpp"
@@ -64,84 +68,81 @@ double uniform(Rng& rng, double lo, double hi) {
   return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
 
-TEST(ModelHessian, CarMatchesDifferencesOfTheJacobians) {
-  const Car car{2.5};
-  Rng rng(41);
+// A model's weighted_hessian and step_hessian (step h) against central differences of a' [Fx Fu]
+// and a' [A B] at `trials` points (x, u, a) drawn by `draw`; the worst error of each.
+template <class Model>
+std::pair<double, double> check_model(
+    const Model& model, double h, int trials,
+    const std::function<void(int, typename Model::State&, typename Model::Control&,
+                             typename Model::State&)>& draw) {
+  using State = typename Model::State;
+  using Control = typename Model::Control;
+  constexpr int n = State::RowsAtCompileTime, m = Control::RowsAtCompileTime;
+  using StateMatrix = Eigen::Matrix<double, n, n>;
+  using ControlMatrix = Eigen::Matrix<double, n, m>;
   double worst_model = 0.0, worst_step = 0.0;
-  for (int trial = 0; trial < 300; ++trial) {
-    Car::State x;
-    x << uniform(rng, -5, 5), uniform(rng, -5, 5), uniform(rng, -M_PI, M_PI), uniform(rng, -5, 10),
-        uniform(rng, -1.2, 1.2);
-    const Car::Control u(uniform(rng, -4, 4), uniform(rng, -1, 1));
-    const Car::State a = normal_vector(rng, 5);
-    VectorXd z(7);
+  for (int trial = 0; trial < trials; ++trial) {
+    State x, a;
+    Control u;
+    draw(trial, x, u, a);
+    VectorXd z(n + m);
     z << x, u;
-    const Gradient model = [&](const VectorXd& at) {
-      Car::State xdot;
-      Eigen::Matrix<double, 5, 5> Fx;
-      Eigen::Matrix<double, 5, 2> Fu;
-      car.derivative(at.head<5>(), at.tail<2>(), xdot, Fx, Fu);
-      VectorXd g(7);
+    const auto transposed = [&a](const StateMatrix& Fx, const ControlMatrix& Fu) {
+      VectorXd g(n + m);
       g << Fx.transpose() * a, Fu.transpose() * a;
       return g;
     };
+    const Gradient rate = [&](const VectorXd& at) {
+      State xdot;
+      StateMatrix Fx;
+      ControlMatrix Fu;
+      model.derivative(at.head<n>(), at.tail<m>(), xdot, Fx, Fu);
+      return transposed(Fx, Fu);
+    };
     const Gradient step = [&](const VectorXd& at) {
-      Car::State next;
-      Eigen::Matrix<double, 5, 5> A;
-      Eigen::Matrix<double, 5, 2> B;
-      car.step(0.1, at.head<5>(), at.tail<2>(), next, A, B);
-      VectorXd g(7);
-      g << A.transpose() * a, B.transpose() * a;
-      return g;
+      State next;
+      StateMatrix A;
+      ControlMatrix B;
+      model.step(h, at.head<n>(), at.tail<m>(), next, A, B);
+      return transposed(A, B);
     };
     MatrixXd numeric;
-    ASSERT_TRUE(differences(model, z, 1e-5, numeric));
-    worst_model = std::max(worst_model, error_of(car.weighted_hessian(x, u, a), numeric));
-    ASSERT_TRUE(differences(step, z, 1e-5, numeric));
-    worst_step = std::max(worst_step, error_of(car.step_hessian(0.1, x, u, a), numeric));
+    EXPECT_TRUE(differences(rate, z, 1e-5, numeric)) << "trial " << trial;
+    worst_model = std::max(worst_model, error_of(model.weighted_hessian(x, u, a), numeric));
+    EXPECT_TRUE(differences(step, z, 1e-5, numeric)) << "trial " << trial;
+    worst_step = std::max(worst_step, error_of(model.step_hessian(h, x, u, a), numeric));
   }
+  return {worst_model, worst_step};
+}
+
+TEST(ModelHessian, CarMatchesDifferencesOfTheJacobians) {
+  Rng rng(41);
+  const auto [worst_model, worst_step] =
+      check_model(Car{2.5}, 0.1, 300, [&](int, Car::State& x, Car::Control& u, Car::State& a) {
+        // Steering up to 1.4 rad (tan 5.8), where the heading rate's derivatives grow fast; with
+        // |u2| <= 1 and h = 0.1 the RK4 stages stay below 1.5 rad, short of tan's pole.
+        x << uniform(rng, -5, 5), uniform(rng, -5, 5), uniform(rng, -M_PI, M_PI),
+            uniform(rng, -5, 10), uniform(rng, -1.4, 1.4);
+        u << uniform(rng, -4, 4), uniform(rng, -1, 1);
+        a = normal_vector(rng, 5);
+      });
   EXPECT_LE(worst_model, 1e-7);
   EXPECT_LE(worst_step, 1e-7);
   std::printf("car: worst model %.2g, worst RK4 step %.2g\n", worst_model, worst_step);
 }
 
 TEST(ModelHessian, QuadrotorMatchesDifferencesOfTheJacobians) {
-  const Quadrotor quadrotor;
   Rng rng(42);
-  double worst_model = 0.0, worst_step = 0.0;
-  for (int trial = 0; trial < 200; ++trial) {
-    Quadrotor::State x = normal_vector(rng, 13);
-    x.segment<4>(3).normalize();
-    x.segment<3>(10) *= 3.0;  // angular velocities of a few rad/s
-    const Quadrotor::Control u(uniform(rng, 0, 4), uniform(rng, 0, 4), uniform(rng, 0, 4),
-                               uniform(rng, 0, 4));
-    const Quadrotor::State a = normal_vector(rng, 13);
-    VectorXd z(17);
-    z << x, u;
-    const Gradient model = [&](const VectorXd& at) {
-      Quadrotor::State xdot;
-      Quadrotor::StateMatrix Fx;
-      Quadrotor::ControlMatrix Fu;
-      quadrotor.derivative(at.head<13>(), at.tail<4>(), xdot, Fx, Fu);
-      VectorXd g(17);
-      g << Fx.transpose() * a, Fu.transpose() * a;
-      return g;
-    };
-    const Gradient step = [&](const VectorXd& at) {
-      Quadrotor::State next;
-      Quadrotor::StateMatrix A;
-      Quadrotor::ControlMatrix B;
-      quadrotor.step(0.06, at.head<13>(), at.tail<4>(), next, A, B);
-      VectorXd g(17);
-      g << A.transpose() * a, B.transpose() * a;
-      return g;
-    };
-    MatrixXd numeric;
-    ASSERT_TRUE(differences(model, z, 1e-5, numeric));
-    worst_model = std::max(worst_model, error_of(quadrotor.weighted_hessian(x, u, a), numeric));
-    ASSERT_TRUE(differences(step, z, 1e-5, numeric));
-    worst_step = std::max(worst_step, error_of(quadrotor.step_hessian(0.06, x, u, a), numeric));
-  }
+  const auto [worst_model, worst_step] = check_model(
+      Quadrotor{}, 0.06, 200,
+      [&](int trial, Quadrotor::State& x, Quadrotor::Control& u, Quadrotor::State& a) {
+        x = normal_vector(rng, 13);
+        // Unit and non-unit quaternions: Ipopt's iterates leave the unit sphere between steps.
+        x.segment<4>(3) *= std::array<double, 3>{1.0, 1.7, 0.4}[trial % 3] / x.segment<4>(3).norm();
+        x.segment<3>(10) *= 3.0;  // angular velocities of a few rad/s
+        u << uniform(rng, 0, 4), uniform(rng, 0, 4), uniform(rng, 0, 4), uniform(rng, 0, 4);
+        a = normal_vector(rng, 13);
+      });
   EXPECT_LE(worst_model, 1e-7);
   EXPECT_LE(worst_step, 1e-7);
   std::printf("quadrotor: worst model %.2g, worst RK4 step %.2g\n", worst_model, worst_step);
@@ -256,6 +257,50 @@ TEST(ProblemHessian, ArmShelf) {
     points.emplace_back(k, z);
   }
   EXPECT_GE(check_problem(problem, points, rng, "arm-shelf"), 30);
+}
+
+// Vectors of the wrong size are refused with the field named (the fixed-size models would read
+// past them).
+TEST(ProblemHessian, RefusesVectorsOfTheWrongSize) {
+  const examples::CarBusProblem car_bus{examples::CarBusScenario{}};
+  const examples::QuadrotorWindowProblem quadrotor{examples::QuadrotorWindowScenario{}};
+  const examples::ArmShelfProblem arm{examples::ArmShelfScenario{}};
+  const std::array<std::pair<const Problem*, VectorXd>, 3> problems = {
+      std::pair{static_cast<const Problem*>(&car_bus), car_bus.scenario().x0},
+      std::pair{static_cast<const Problem*>(&quadrotor), quadrotor.scenario().x0},
+      std::pair{static_cast<const Problem*>(&arm), VectorXd(arm.scenario().start)}};
+  for (const auto& entry : problems) {  // valid states: a zero quaternion is refused
+    const Problem* problem = entry.first;
+    const VectorXd& x = entry.second;
+    const int n = problem->state_size(), m = problem->control_size();
+    const VectorXd u = VectorXd::Zero(m);
+    const auto rows = problem->constraint_values(0, x, u).value.size();
+    EXPECT_NO_THROW(problem->dynamics_hessian(x, u, VectorXd::Zero(n)));
+    EXPECT_NO_THROW(problem->constraint_hessian(0, x, u, VectorXd::Zero(rows)));
+    const auto message = [](const auto& call) {
+      try {
+        call();
+      } catch (const std::invalid_argument& error) {
+        return std::string(error.what());
+      }
+      return std::string("no exception");
+    };
+    EXPECT_EQ(message([&] {
+                problem->dynamics_hessian(x, u, VectorXd::Zero(n - 1));
+              }).rfind("lambda: expected", 0),
+              0u);
+    EXPECT_EQ(message([&] {
+                problem->dynamics_hessian(VectorXd::Zero(n + 1), u, x);
+              }).rfind("x: expected", 0),
+              0u);
+    EXPECT_EQ(
+        message([&] { problem->constraint_hessian(0, x, u, VectorXd()); }).rfind("mu: expected", 0),
+        0u);
+    EXPECT_EQ(message([&] {
+                problem->constraint_hessian(0, x, VectorXd(), VectorXd::Zero(rows));
+              }).rfind("u: expected", 0),
+              0u);
+  }
 }
 
 }  // namespace

@@ -248,8 +248,12 @@ trajopt::KnotConstraints ArmShelfProblem::evaluate(int k, const Eigen::VectorXd&
   return out;
 }
 
-Eigen::MatrixXd ArmShelfProblem::dynamics_hessian(const Eigen::VectorXd&, const Eigen::VectorXd&,
-                                                  const Eigen::VectorXd&) const {
+Eigen::MatrixXd ArmShelfProblem::dynamics_hessian(const Eigen::VectorXd& x,
+                                                  const Eigen::VectorXd& u,
+                                                  const Eigen::VectorXd& lambda) const {
+  trajopt::require_size(x, 7, "x");
+  trajopt::require_size(u, 7, "u");
+  trajopt::require_size(lambda, 7, "lambda");
   return Eigen::MatrixXd::Zero(14, 14);  // x + dt u is linear
 }
 
@@ -299,9 +303,12 @@ Eigen::MatrixXd ArmShelfProblem::constraint_hessian(int k, const Eigen::VectorXd
                                                     const Eigen::VectorXd& u,
                                                     const Eigen::VectorXd& mu) const {
   const bool last = k == knots() - 1;
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(7 + u.size(), 7 + u.size());
   const auto pair_count = static_cast<Eigen::Index>(pairs_.size());
   const int substeps = last ? 1 : scenario_.substeps;
+  trajopt::require_size(x, 7, "x");
+  trajopt::require_size(u, last ? 0 : 7, "u");
+  trajopt::require_size(mu, collision_start(last) + substeps * pair_count, "mu");
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(7 + u.size(), 7 + u.size());
   for (int step = 0; step < substeps; ++step) {
     const double c = static_cast<double>(step) / scenario_.substeps * scenario_.dt;
     const Eigen::VectorXd q = last ? x : Eigen::VectorXd(x + c * u);

@@ -92,6 +92,9 @@ void CarBusProblem::dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
 
 Eigen::MatrixXd CarBusProblem::dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                                 const Eigen::VectorXd& lambda) const {
+  trajopt::require_size(x, 5, "x");
+  trajopt::require_size(u, 2, "u");
+  trajopt::require_size(lambda, 5, "lambda");
   return scenario_.car_model.step_hessian(scenario_.dt, x, u, lambda);
 }
 
@@ -101,6 +104,9 @@ Eigen::MatrixXd CarBusProblem::constraint_hessian(int k, const Eigen::VectorXd& 
                                                   const Eigen::VectorXd& u,
                                                   const Eigen::VectorXd& mu) const {
   const bool last = k == scenario_.knots - 1;
+  trajopt::require_size(x, 5, "x");
+  trajopt::require_size(u, last ? 0 : 2, "u");
+  trajopt::require_size(mu, last ? 4 : 5, "mu");  // evaluate_constraints' rows
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(5 + u.size(), 5 + u.size());
   H.topLeftCorner<5, 5>() = -mu(last ? 3 : 0) * car_bus_clearance_hessian(scenario_, x);
   return H;

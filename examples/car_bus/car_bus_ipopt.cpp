@@ -145,22 +145,15 @@ class CarBusNlp : public Ipopt::TNLP {
       hessian_.structure(rows, cols);
       return true;
     }
-    std::fill(values, values + hessian_.nonzeros(), 0.0);
-    for (int k = 0; k < layout_.knots; ++k) {
-      const Eigen::VectorXd x = state(z, k);
-      const bool last = k + 1 == layout_.knots;
-      const Eigen::VectorXd u = last ? Eigen::VectorXd() : control(z, k);
-      Eigen::MatrixXd block =
-          cost_block(last ? problem_.terminal_cost(x) : problem_.stage_cost(k, x, u), obj_factor);
-      if (!last) {
-        const Eigen::Map<const Eigen::VectorXd> defect(lambda + layout_.state(k), kState);
-        block += problem_.dynamics_hessian(x, u, -defect);
-      }
-      block.topLeftCorner<kState, kState>() +=
-          lambda[layout_.defects() + k] * car_bus_phi_hessian(problem_.scenario(), x);
-      hessian_.add(k, block, values);
-    }
-    return true;
+    return hessian_.evaluate(
+        problem_, z, obj_factor, lambda,
+        [&](int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u) -> Eigen::MatrixXd {
+          Eigen::MatrixXd H = Eigen::MatrixXd::Zero(kState + u.size(), kState + u.size());
+          H.topLeftCorner<kState, kState>() =
+              lambda[layout_.defects() + k] * car_bus_phi_hessian(problem_.scenario(), x);
+          return H;
+        },
+        values);
   }
 
   void finalize_solution(Ipopt::SolverReturn status, Index, const Number* z, const Number*,

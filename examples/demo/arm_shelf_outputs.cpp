@@ -83,7 +83,7 @@ ArmShelfRun solve_arm_shelf(const ArmShelfProblem& problem, const DemoSettings& 
 
 void write_arm_shelf_csv(const ArmShelfProblem& problem, const ArmShelfRun& run,
                          const std::filesystem::path& path) {
-  std::ofstream out(path);
+  std::ostringstream out;
   out << std::setprecision(17) << "t,q1,q2,q3,q4,q5,q6,q7\n";
   const auto& states = run.result.states;
   for (std::size_t k = 0; k < states.size(); ++k) {
@@ -91,6 +91,7 @@ void write_arm_shelf_csv(const ArmShelfProblem& problem, const ArmShelfRun& run,
     for (int i = 0; i < 7; ++i) out << "," << states[k](i);
     out << "\n";
   }
+  write_file(path, out.str());
 }
 
 void write_arm_shelf_json(const ArmShelfProblem& problem, const ArmShelfRun& run,
@@ -132,8 +133,8 @@ void write_arm_shelf_json(const ArmShelfProblem& problem, const ArmShelfRun& run
               {"path_min_distance", run.path_min_distance},
               {"straight_line_min_distance", run.straight_line_min_distance},
               {"solver", altro_summary(run.result, run.solve_ms)}};
-  add_ipopt_comparison(out, run.ipopt, run.solve_ms, run.runs);
-  std::ofstream(path) << out.dump(2) << "\n";
+  add_ipopt_comparison(out, run.ipopt, run.result, run.solve_ms, run.runs);
+  write_file(path, out.dump(2) + "\n");
 }
 
 void write_arm_shelf_svg(const ArmShelfProblem& problem, const ArmShelfRun& run,
@@ -182,7 +183,7 @@ void write_arm_shelf_svg(const ArmShelfProblem& problem, const ArmShelfRun& run,
            14);
   svg.text({-1.0, -0.03}, "from behind the robot (along +x)", 14);
   svg.text({0.5, -0.03}, "from the right (along +y)", 14);
-  std::ofstream(path) << svg.str();
+  write_file(path, svg.str());
 }
 
 }  // namespace diffpills::examples

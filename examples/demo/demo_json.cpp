@@ -1,8 +1,17 @@
 #include "demo_json.hpp"
 
+#include <fstream>
+#include <stdexcept>
 #include <vector>
 
 namespace diffpills::examples {
+
+void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+}
 
 nlohmann::ordered_json json_list(const Eigen::VectorXd& v) {
   return nlohmann::ordered_json(std::vector<double>(v.data(), v.data() + v.size()));

@@ -2,12 +2,18 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "diffpills/trajopt/altro.hpp"
 #include "ipopt/ipopt_run.hpp"
 
 namespace diffpills::examples {
+
+// Writes text to path, or throws std::runtime_error naming the path (a folder that cannot be
+// written, a full disk): a demo that wrote nothing must not say where its files are.
+void write_file(const std::filesystem::path& path, const std::string& text);
 
 // A vector as a JSON list of numbers.
 nlohmann::ordered_json json_list(const Eigen::VectorXd& v);

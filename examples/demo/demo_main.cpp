@@ -16,6 +16,8 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <utility>
 
 #include "arm_shelf_outputs.hpp"
 #include "car_bus/car_bus.hpp"
@@ -71,7 +73,7 @@ CarBusRun solve_car_bus(const examples::CarBusProblem& problem,
 
 void write_car_bus_csv(const examples::CarBusProblem& problem, const CarBusRun& run,
                        const std::filesystem::path& path) {
-  std::ofstream out(path);
+  std::ostringstream out;
   out << std::setprecision(17) << "k,t,px,py,theta,v,gamma,u1,u2\n";
   const auto& states = run.result.states;
   for (std::size_t k = 0; k < states.size(); ++k) {
@@ -83,6 +85,7 @@ void write_car_bus_csv(const examples::CarBusProblem& problem, const CarBusRun& 
       out << ",,\n";
     }
   }
+  examples::write_file(path, out.str());
 }
 
 void write_car_bus_json(const examples::CarBusProblem& problem, const CarBusRun& run,
@@ -100,8 +103,8 @@ void write_car_bus_json(const examples::CarBusProblem& problem, const CarBusRun&
               {"control_limit", json_list(s.control_limit)},
               {"initial_guess_min_phi", run.guess_min_phi},
               {"solver", altro_summary(run.result, run.solve_ms)}};
-  examples::add_ipopt_comparison(out, run.ipopt, run.solve_ms, run.runs);
-  std::ofstream(path) << out.dump(2) << "\n";
+  examples::add_ipopt_comparison(out, run.ipopt, run.result, run.solve_ms, run.runs);
+  examples::write_file(path, out.dump(2) + "\n");
 }
 
 // Top view: the bus, the car's capsule every fifth knot, its path, start and goal.
@@ -130,7 +133,7 @@ void write_car_bus_svg(const examples::CarBusProblem& problem, const CarBusRun& 
   svg.circle(s.goal.head<2>(), 5, "#d62728");
   svg.text(s.goal.head<2>() + Eigen::Vector2d(-0.5, -1.6), "goal");
   svg.text({-2.5, 3.0}, "car-bus: ALTRO, phi(car, bus) >= 0 at every knot", 16);
-  std::ofstream(path) << svg.str();
+  examples::write_file(path, svg.str());
 }
 
 // The paper's Fig. 1 in an orthographic view: the silhouettes of both padded shapes are exactly
@@ -168,7 +171,7 @@ void write_scene_svg(const std::filesystem::path& path) {
   label << std::setprecision(4) << "phi = " << p.phi
         << " (apart); red: closest points, green: normal";
   svg.text({-1.05, 1.65}, label.str(), 15);
-  std::ofstream(path) << svg.str();
+  examples::write_file(path, svg.str());
 }
 
 // The quadrotor behind a thin wall (panels and body padded by 0.025 m each): the same problem
@@ -186,8 +189,9 @@ examples::AltroRun solve_thin_wall(examples::Clearance clearance,
   });
 }
 
-// One row of the summary table: ALTRO's run, then each Ipopt run's time and cost, and ALTRO's
-// speed-up over the faster one ("-" without Ipopt).
+// One row of the summary table: ALTRO's run, then each Ipopt run's time and cost ("failed" for
+// one that did not solve), and ALTRO's speed-up over the faster solved one, marked * where that
+// Ipopt run found another local minimum ("-" without Ipopt).
 void print_row(const std::string& name, const trajopt::AltroResult& result, double solve_ms,
                const std::optional<examples::IpoptRuns>& ipopt) {
   std::cout << std::left << std::setw(18) << name << std::right << std::setw(8)
@@ -196,29 +200,48 @@ void print_row(const std::string& name, const trajopt::AltroResult& result, doub
             << result.max_violation << std::setw(12) << std::setprecision(6) << result.cost
             << std::setw(10) << std::setprecision(3) << solve_ms;
   if (!ipopt) {
-    std::cout << std::setw(14) << "-" << std::setw(12) << "-" << std::setw(14) << "-"
+    std::cout << std::setw(14) << "-" << std::setw(12) << "-" << std::setw(16) << "-"
               << std::setw(12) << "-" << std::setw(10) << "-\n";
     return;
   }
-  for (const examples::IpoptRun* run : {&ipopt->limited_memory, &ipopt->exact}) {
-    std::cout << std::setw(14) << std::setprecision(4) << run->solve_ms << std::setw(12)
-              << std::setprecision(6) << run->cost;
+  for (const auto& [run, width] :
+       {std::pair{&ipopt->limited_memory, 14}, std::pair{&ipopt->exact, 16}}) {
+    if (run->solved) {
+      std::cout << std::setw(width) << std::setprecision(4) << run->solve_ms << std::setw(12)
+                << std::setprecision(6) << run->cost;
+    } else {
+      std::cout << std::setw(width) << "failed" << std::setw(12) << "-";
+    }
   }
-  std::cout << std::setw(9) << std::setprecision(3) << ipopt->faster().solve_ms / solve_ms << "x\n";
+  const examples::IpoptRun* faster = ipopt->faster_solved();
+  if (faster == nullptr) {
+    std::cout << std::setw(10) << "-\n";
+    return;
+  }
+  std::ostringstream ratio;
+  ratio << std::setprecision(3) << faster->solve_ms / solve_ms << "x"
+        << (examples::same_minimum(faster->cost, result.cost) ? "" : "*");
+  std::cout << std::setw(10) << ratio.str() << "\n";
 }
 
 int run(int argc, char** argv) {
   std::filesystem::path out_dir = "out";
   examples::DemoSettings settings;
+  bool folder_given = false;
+  constexpr const char* kUsage = "usage: diffpills_demo [output folder, default out] [--quick]\n";
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
     if (argument == "--quick") {
       settings.quick = true;
-    } else if (argument.rfind("--", 0) == 0) {
-      std::cerr << "usage: diffpills_demo [output folder] [--quick]\n";
+    } else if (argument == "--help" || argument == "-h") {
+      std::cout << kUsage;
+      return 0;
+    } else if (argument.empty() || argument[0] == '-' || folder_given) {
+      std::cerr << "diffpills_demo: unexpected argument '" << argument << "'\n" << kUsage;
       return 2;
     } else {
       out_dir = argument;
+      folder_given = true;
     }
   }
   std::filesystem::create_directories(out_dir);
@@ -245,8 +268,8 @@ int run(int argc, char** argv) {
   std::cout << std::left << std::setw(18) << "problem" << std::right << std::setw(8) << "status"
             << std::setw(12) << "iterations" << std::setw(15) << "max violation" << std::setw(12)
             << "cost" << std::setw(10) << "ms" << std::setw(14) << "Ipopt L-M ms" << std::setw(12)
-            << "cost" << std::setw(14) << "Ipopt exact" << std::setw(12) << "cost" << std::setw(10)
-            << "speed-up"
+            << "cost" << std::setw(16) << "Ipopt exact ms" << std::setw(12) << "cost"
+            << std::setw(10) << "speed-up"
             << "\n";
   print_row("car_bus", run.result, run.solve_ms, run.ipopt);
   print_row("quadrotor_window", flight.result, flight.solve_ms, flight.ipopt);
@@ -259,7 +282,8 @@ int run(int argc, char** argv) {
   std::cout << "\nALTRO and Ipopt from the same guess; the fastest run of " << run.runs
             << " per solver (the arm: " << reach.runs
             << "); Ipopt with its limited-memory (L-M) and its exact Hessian; speed-up: the "
-               "faster Ipopt's time over ALTRO's\n";
+               "faster solved Ipopt's time over ALTRO's (*: that Ipopt run stopped at another "
+               "local minimum, its cost more than 1% from ALTRO's)\n";
   std::cout << std::setprecision(3)
             << "car_bus: straight-line initial guess collides, smallest phi " << run.guess_min_phi
             << "\nquadrotor_window: the level body slid straight through has "

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "demo_json.hpp"
 #include "ipopt/problem_nlp.hpp"
@@ -61,7 +62,7 @@ QuadrotorWindowRun solve_quadrotor_window(const QuadrotorWindowProblem& problem,
 
 void write_quadrotor_window_csv(const QuadrotorWindowProblem& problem,
                                 const QuadrotorWindowRun& run, const std::filesystem::path& path) {
-  std::ofstream out(path);
+  std::ostringstream out;
   out << std::setprecision(17) << "k,t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,u1,u2,u3,u4\n";
   const auto& states = run.result.states;
   for (std::size_t k = 0; k < states.size(); ++k) {
@@ -73,6 +74,7 @@ void write_quadrotor_window_csv(const QuadrotorWindowProblem& problem,
     }
     out << "\n";
   }
+  write_file(path, out.str());
 }
 
 void write_quadrotor_window_json(const QuadrotorWindowProblem& problem,
@@ -110,8 +112,8 @@ void write_quadrotor_window_json(const QuadrotorWindowProblem& problem,
               {"min_phi", run.min_phi},
               {"largest_tilt_deg", run.largest_tilt_deg},
               {"solver", altro_summary(run.result, run.solve_ms)}};
-  add_ipopt_comparison(out, run.ipopt, run.solve_ms, run.runs);
-  std::ofstream(path) << out.dump(2) << "\n";
+  add_ipopt_comparison(out, run.ipopt, run.result, run.solve_ms, run.runs);
+  write_file(path, out.dump(2) + "\n");
 }
 
 // Three orthographic views on one canvas: top (x, y) above, side (x, z) below, and on the right
@@ -179,7 +181,7 @@ void write_quadrotor_window_svg(const QuadrotorWindowProblem& problem,
   std::ostringstream label;
   label << std::setprecision(3) << "largest tilt " << run.largest_tilt_deg << " deg";
   svg.text({7.6, 1.9}, label.str(), 14);
-  std::ofstream(path) << svg.str();
+  write_file(path, svg.str());
 }
 
 }  // namespace diffpills::examples

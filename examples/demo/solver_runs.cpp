@@ -32,14 +32,32 @@ IpoptRuns fastest_ipopt(int runs, const std::function<IpoptRun(IpoptHessian)>& s
   return fastest;
 }
 
+const IpoptRun* IpoptRuns::faster_solved() const {
+  const IpoptRun* faster = nullptr;
+  for (const IpoptRun* run : {&limited_memory, &exact}) {
+    if (run->solved && (faster == nullptr || run->solve_ms < faster->solve_ms)) faster = run;
+  }
+  return faster;
+}
+
+bool same_minimum(double cost, double altro_cost) {
+  return std::abs(cost - altro_cost) <= 0.01 * std::abs(altro_cost);
+}
+
 void add_ipopt_comparison(nlohmann::ordered_json& out, const std::optional<IpoptRuns>& ipopt,
-                          double altro_ms, int runs) {
+                          const trajopt::AltroResult& altro, double altro_ms, int runs) {
   if (!ipopt) return;
   out["ipopt"] = ipopt_summary(ipopt->limited_memory);
   out["ipopt_exact"] = ipopt_summary(ipopt->exact);
-  out["altro_speedup"] = {{"over", to_string(ipopt->faster().hessian)},
-                          {"ratio", ipopt->faster().solve_ms / altro_ms},
-                          {"runs", runs}};
+  const IpoptRun* faster = ipopt->faster_solved();
+  if (faster == nullptr) {
+    out["altro_speedup"] = nullptr;
+    return;
+  }
+  out["altro_speedup"] = {{"over", to_string(faster->hessian)},
+                          {"ratio", faster->solve_ms / altro_ms},
+                          {"runs", runs},
+                          {"same_minimum", same_minimum(faster->cost, altro.cost)}};
 }
 
 }  // namespace diffpills::examples

@@ -1,7 +1,8 @@
 // How the demo times its solvers, every one of a problem the same way: the fastest of the same
-// number of runs (not a cold-cache outlier, and no solver gets more tries than another), ALTRO
-// timed around trajopt::solve, Ipopt around its solve alone (timed_solve.hpp); Ipopt with both of
-// its Hessians (limited-memory and exact), and ALTRO's speed-up over the faster of the two.
+// number of runs (no solver gets more tries than another; with several, no time is a cold-cache
+// outlier), ALTRO timed around trajopt::solve, Ipopt around its solve alone (timed_solve.hpp);
+// Ipopt with both of its Hessians (limited-memory and exact), and ALTRO's speed-up over the
+// faster of the two that solved.
 #pragma once
 
 #include <functional>
@@ -31,17 +32,21 @@ AltroRun fastest_altro(int runs, const std::function<trajopt::AltroResult()>& so
 
 struct IpoptRuns {
   IpoptRun limited_memory, exact;
-  const IpoptRun& faster() const {
-    return exact.solve_ms < limited_memory.solve_ms ? exact : limited_memory;
-  }
+  // The faster of the runs that solved, or nullptr if neither did.
+  const IpoptRun* faster_solved() const;
 };
 // solve(hessian) runs Ipopt once with that Hessian.
 IpoptRuns fastest_ipopt(int runs, const std::function<IpoptRun(IpoptHessian)>& solve);
 
+// Whether two solvers' costs are one local minimum's (within 1%): a speed-up between different
+// minima compares different answers.
+bool same_minimum(double cost, double altro_cost);
+
 // The "ipopt" (limited-memory) and "ipopt_exact" blocks (demo_json.hpp's ipopt_summary), and
-// "altro_speedup": {"over": the faster Ipopt's Hessian, "ratio": its solve_ms over ALTRO's,
-// "runs": runs per solver}; nothing without Ipopt runs.
+// "altro_speedup": {"over": the faster solved Ipopt's Hessian, "ratio": its solve_ms over ALTRO's,
+// "runs": runs per solver, "same_minimum": same_minimum of the two costs}, null if neither Ipopt
+// run solved; nothing without Ipopt runs.
 void add_ipopt_comparison(nlohmann::ordered_json& out, const std::optional<IpoptRuns>& ipopt,
-                          double altro_ms, int runs);
+                          const trajopt::AltroResult& altro, double altro_ms, int runs);
 
 }  // namespace diffpills::examples

@@ -33,7 +33,9 @@ IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& re
   app->Options()->SetIntegerValue("max_iter", 3000);
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");  // no banner
-  Ipopt::ApplicationReturnStatus status = app->Initialize();
+  // "": no options file. Ipopt otherwise reads ./ipopt.opt, and the runs would depend on the
+  // folder they are started from.
+  Ipopt::ApplicationReturnStatus status = app->Initialize("");
   double solve_ms = 0.0;
   if (status == Ipopt::Solve_Succeeded) {
     const auto start = std::chrono::steady_clock::now();

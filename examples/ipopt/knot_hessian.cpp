@@ -1,5 +1,7 @@
 #include "knot_hessian.hpp"
 
+#include <algorithm>
+
 namespace diffpills::examples {
 
 KnotHessian::KnotHessian(int state_size, int control_size, int knots)
@@ -30,13 +32,9 @@ void KnotHessian::structure(int* rows, int* cols) const {
   }
 }
 
-void KnotHessian::add(int k, const Eigen::MatrixXd& block, double* values) const {
-  int entry = first_[static_cast<std::size_t>(k)];
-  for (Eigen::Index i = 0; i < block.rows(); ++i) {
-    for (Eigen::Index j = 0; j <= i; ++j) values[entry++] += block(i, j);
-  }
-}
+namespace {
 
+// objective_factor * the costs' Hessian as one [x; u] block (xx alone at the last knot).
 Eigen::MatrixXd cost_block(const trajopt::CostExpansion& cost, double objective_factor) {
   const Eigen::Index n = cost.xx.rows(), m = cost.uu.rows();
   Eigen::MatrixXd block = Eigen::MatrixXd::Zero(n + m, n + m);
@@ -47,6 +45,36 @@ Eigen::MatrixXd cost_block(const trajopt::CostExpansion& cost, double objective_
     block.topRightCorner(n, m) = cost.ux.transpose();
   }
   return objective_factor * block;
+}
+
+}  // namespace
+
+bool KnotHessian::evaluate(const trajopt::Problem& problem, const double* z,
+                           double objective_factor, const double* defect_multipliers,
+                           const ConstraintHessian& constraints, double* values) const {
+  std::fill(values, values + nonzeros(), 0.0);
+  for (int k = 0; k < knots_; ++k) {
+    const bool last = k + 1 == knots_;
+    const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(z + variable(k, 0), n_);
+    const Eigen::VectorXd u =
+        last ? Eigen::VectorXd()
+             : Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(z + variable(k, n_), m_));
+    Eigen::MatrixXd block =
+        cost_block(last ? problem.terminal_cost(x) : problem.stage_cost(k, x, u), objective_factor);
+    if (!last) {
+      const Eigen::Map<const Eigen::VectorXd> defect(defect_multipliers + std::ptrdiff_t{n_} * k,
+                                                     n_);
+      block += problem.dynamics_hessian(x, u, -defect);
+    }
+    block += constraints(k, x, u);
+    const Eigen::Index size = n_ + u.size();
+    if (block.rows() != size || block.cols() != size) return false;
+    int entry = first_[static_cast<std::size_t>(k)];
+    for (Eigen::Index i = 0; i < size; ++i) {
+      for (Eigen::Index j = 0; j <= i; ++j) values[entry++] = block(i, j);
+    }
+  }
+  return true;
 }
 
 }  // namespace diffpills::examples

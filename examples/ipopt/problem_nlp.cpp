@@ -158,24 +158,15 @@ class ProblemNlp : public Ipopt::TNLP {
       hessian_.structure(rows, cols);
       return true;
     }
-    std::fill(values, values + hessian_.nonzeros(), 0.0);
-    for (int k = 0; k < knots_; ++k) {
-      const auto s = static_cast<std::size_t>(k);
-      const Eigen::VectorXd x = state(z, k), u = control_or_empty(k, z);
-      const bool last = k + 1 == knots_;
-      Eigen::MatrixXd block =
-          cost_block(last ? problem_.terminal_cost(x) : problem_.stage_cost(k, x, u), obj_factor);
-      if (!last) {
-        const Eigen::Map<const Eigen::VectorXd> defect(lambda + std::ptrdiff_t{n_} * k, n_);
-        block += problem_.dynamics_hessian(x, u, -defect);
-      }
-      if (rows_[s] > 0) {
-        block += problem_.constraint_hessian(
-            k, x, u, Eigen::Map<const Eigen::VectorXd>(lambda + row_start_[s], rows_[s]));
-      }
-      hessian_.add(k, block, values);
-    }
-    return true;
+    return hessian_.evaluate(
+        problem_, z, obj_factor, lambda,
+        [&](int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u) -> Eigen::MatrixXd {
+          const auto s = static_cast<std::size_t>(k);
+          if (rows_[s] == 0) return Eigen::MatrixXd::Zero(n_ + u.size(), n_ + u.size());
+          return problem_.constraint_hessian(
+              k, x, u, Eigen::Map<const Eigen::VectorXd>(lambda + row_start_[s], rows_[s]));
+        },
+        values);
   }
 
   void finalize_solution(Ipopt::SolverReturn status, Index, const Number* z, const Number*,

@@ -9,9 +9,9 @@
 namespace diffpills::examples {
 
 // Solves nlp with the given Hessian (the NLP's eval_h for kExact), tol 1e-8, constr_viol_tol 1e-6
-// and at most 3,000 iterations, timing the solve alone (not option parsing). `result` is where the
-// NLP's finalize_solution writes, read after the solve; the run returned is it with the Hessian
-// used, the status, the iteration count and the time.
+// and at most 3,000 iterations (no options file), timing the solve alone (not option parsing).
+// `result` is where the NLP's finalize_solution writes, read after the solve; the run returned is
+// it with the Hessian used, the status, the iteration count and the time.
 IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& result,
                      IpoptHessian hessian);
 

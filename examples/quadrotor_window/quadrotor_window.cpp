@@ -203,6 +203,9 @@ trajopt::KnotConstraints QuadrotorWindowProblem::evaluate_constraints(int k,
 Eigen::MatrixXd QuadrotorWindowProblem::dynamics_hessian(const Eigen::VectorXd& x,
                                                          const Eigen::VectorXd& u,
                                                          const Eigen::VectorXd& lambda) const {
+  trajopt::require_size(x, 13, "x");
+  trajopt::require_size(u, 4, "u");
+  trajopt::require_size(lambda, 13, "lambda");
   return scenario_.model.step_hessian(scenario_.dt, x, u, lambda);
 }
 
@@ -212,6 +215,9 @@ Eigen::MatrixXd QuadrotorWindowProblem::constraint_hessian(int k, const Eigen::V
                                                            const Eigen::VectorXd& u,
                                                            const Eigen::VectorXd& mu) const {
   const bool last = k == scenario_.knots - 1;
+  trajopt::require_size(x, 13, "x");
+  trajopt::require_size(u, last ? 0 : 4, "u");
+  trajopt::require_size(mu, (last ? 3 : 0) + obstacle_count() + (last ? 0 : 8), "mu");
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(13 + u.size(), 13 + u.size());
   const Pose pose = quadrotor_pose(x);
   int row = last ? 3 : 0;

@@ -20,6 +20,13 @@ KnotConstraints Problem::constraints(int /*k*/, const Eigen::VectorXd& x,
   return none;
 }
 
+void require_size(const Eigen::VectorXd& v, Eigen::Index size, const char* name) {
+  if (v.size() != size) {
+    throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(size) +
+                                " entries, got " + std::to_string(v.size()));
+  }
+}
+
 Eigen::MatrixXd Problem::dynamics_hessian(const Eigen::VectorXd&, const Eigen::VectorXd&,
                                           const Eigen::VectorXd&) const {
   throw std::logic_error("dynamics_hessian: this problem supplies no second derivatives");

@@ -76,6 +76,7 @@ class Problem {
   // std::logic_error.
   virtual bool has_second_derivatives() const { return false; }
   // The Hessian of lambda' f(x, u) with respect to [x; u], (n + m) x (n + m), for lambda in R^n.
+  // Both throw std::invalid_argument for vectors of the wrong size (require_size below).
   virtual Eigen::MatrixXd dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
                                            const Eigen::VectorXd& lambda) const;
   // The Hessian of mu' [e_k; c_k](x, u) with respect to [x; u] (x alone at the last knot), for one
@@ -84,5 +85,10 @@ class Problem {
                                              const Eigen::VectorXd& u,
                                              const Eigen::VectorXd& mu) const;
 };
+
+// Throws std::invalid_argument("<name>: expected <size> entries, got <v.size()>") unless v has size
+// entries: for the second-derivative functions, whose fixed-size models would otherwise read past
+// a short vector.
+void require_size(const Eigen::VectorXd& v, Eigen::Index size, const char* name);
 
 }  // namespace diffpills::trajopt

@@ -19,9 +19,9 @@
 // with central differences and the poses with the 4x4 products written out separately. The same
 // holds for any point p and attitude q_p fixed in frame f (a shape posed in it).
 //
-// Second derivatives (attached_pose_curvature). For i <= j <= f, joint i turns z_j, p and o_j
-// alike (z_j by z_i x z_j, p - o_j by z_i x (p - o_j)), and joint j leaves z_j and o_j where
-// they are, so with the Jacobi identity
+// Second derivatives (attached_pose_derivatives' curvature). For i <= j <= f, joint i turns z_j, p
+// and o_j alike (z_j by z_i x z_j, p - o_j by z_i x (p - o_j)), and joint j leaves z_j and o_j
+// where they are, so with the Jacobi identity
 //     d2 p / dq_i dq_j = z_i x (z_j x (p - o_j)),    d2 q_p / dq_i dq_j = 1/4 [0, z_i] (x) [0, z_j]
 //     (x) q_p
 // (the second: 1/2 [0, z_i x z_j] (x) q_p + 1/4 [0, z_j] (x) [0, z_i] (x) q_p, and
