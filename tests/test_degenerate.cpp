@@ -363,5 +363,46 @@ TEST(Degenerate, SliversAgainstTheBruteForce) {
   EXPECT_NEAR(proximity(plate, above, spike, Pose()).phi, expected, 1e-12);
 }
 
+// fuzz_proximity's needle: a strip 1.2e-91 wide whose two sides differ in direction by 3e-16, so
+// that they cross 4e-76 from the origin; the row through the origin (d = 1e-300) is dropped as
+// cutting off nothing resolvable, and the polygon is a triangle 1.4 long and 5e-15 wide at its
+// far end. Beyond its apex, points satisfy both sides to rounding: the interior-point reference
+// returned one 0.4 beyond the tip (phi 0.16 too small). The default path is exact against the
+// vertices written out here; the reference either agrees or reports SolverError.
+TEST(Degenerate, NeedleWhoseApexIsBelowTheRounding) {
+  const Eigen::Vector2d strip(0.20260703884442144, 0.97926012264908202);
+  Eigen::MatrixX2d C(4, 2);
+  C << -strip.transpose(), 0.20260703884442111, 0.97926012264908202, -0.47679923006332192,
+      0.87901222642863353, -0.11479492660650993, -0.99338921114808065;
+  const PaddedPolygon needle(
+      C, Eigen::Vector4d(6.1363668316221582e-92, 6.1363668316221582e-92, 1e-300, 0.125), 0.0);
+  const Pose pose({2, 1.25, 1.25}, {-0.5, 0.5, -0.5, 0.5});
+  const Capsule capsule(2.875, 2.875);
+  const Pose capsule_pose({1.25, 1.25, -0.75}, kIdentity);
+  // The needle as a segment from the origin along t = (strip.y, -strip.x) to row 3's cut at
+  // 0.125 / ((-0.1148, -0.9934) . t): its width (< 1e-14) is below what the check resolves.
+  const Eigen::Vector2d t(strip.y(), -strip.x());
+  const double length = 0.125 / C.row(3).dot(t);
+  const TestShape as_segment{
+      needle, {Eigen::Vector3d::Zero(), Eigen::Vector3d(t.x(), t.y(), 0) * length}, 1.0};
+  const TestShape core{
+      capsule, {Eigen::Vector3d(-1.4375, 0, 0), Eigen::Vector3d(1.4375, 0, 0)}, 1.0};
+  const long double gap =
+      brute_force_closest(to_world(as_segment, pose), to_world(core, capsule_pose)).distance;
+  const double expected = static_cast<double>(gap * gap) - 2.875 * 2.875;
+  EXPECT_NEAR(proximity(needle, pose, capsule, capsule_pose).phi, expected, 1e-12);
+  EXPECT_NEAR(proximity(capsule, capsule_pose, needle, pose).phi, expected, 1e-12);
+  for (const bool swapped : {false, true}) {
+    try {
+      const double phi =
+          swapped ? proximity(capsule, capsule_pose, needle, pose, {Method::kInteriorPoint}).phi
+                  : proximity(needle, pose, capsule, capsule_pose, {Method::kInteriorPoint}).phi;
+      EXPECT_NEAR(phi, expected, 1e-6) << "swapped " << swapped;
+    } catch (const SolverError&) {
+      // the documented answer where the reference cannot resolve the spike
+    }
+  }
+}
+
 }  // namespace
 }  // namespace diffpills::testing

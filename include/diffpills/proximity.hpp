@@ -119,7 +119,9 @@ struct ProximityHessian : ProximityJacobian {
   Eigen::Matrix<double, 14, 14> hessian = Eigen::Matrix<double, 14, 14>::Zero();
 };
 
-// Thrown when the QP solver does not converge (never silently wrong).
+// Thrown when the QP solver does not converge, or when the interior-point reference's point lies
+// outside a polygon's spike sharper than its tolerance (src/proximity/proximity.cpp): never
+// silently wrong.
 class SolverError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
