@@ -207,8 +207,10 @@ void print_row(const std::string& name, const trajopt::AltroResult& result, doub
   for (const auto& [run, width] :
        {std::pair{&ipopt->limited_memory, 14}, std::pair{&ipopt->exact, 16}}) {
     if (run->solved) {
-      std::cout << std::setw(width) << std::setprecision(4) << run->solve_ms << std::setw(12)
-                << std::setprecision(6) << run->cost;
+      std::ostringstream ms;  // fixed: a minute is 64195.3, not 6.42e+04
+      ms << std::fixed << std::setprecision(1) << run->solve_ms;
+      std::cout << std::setw(width) << ms.str() << std::setw(12) << std::setprecision(6)
+                << run->cost;
     } else {
       std::cout << std::setw(width) << "failed" << std::setw(12) << "-";
     }
