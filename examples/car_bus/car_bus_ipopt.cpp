@@ -141,11 +141,7 @@ class CarBusNlp : public Ipopt::TNLP {
   // -f(x_k, u_k) weighted by its multipliers, and phi(x_k) weighted by its multiplier.
   bool eval_h(Index, const Number* z, bool, Number obj_factor, Index, const Number* lambda, bool,
               Index, Index* rows, Index* cols, Number* values) override {
-    if (values == nullptr) {
-      hessian_.structure(rows, cols);
-      return true;
-    }
-    return hessian_.evaluate(
+    return hessian_.eval_h(
         problem_, z, obj_factor, lambda,
         [&](int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u) -> Eigen::MatrixXd {
           Eigen::MatrixXd H = Eigen::MatrixXd::Zero(kState + u.size(), kState + u.size());
@@ -153,7 +149,7 @@ class CarBusNlp : public Ipopt::TNLP {
               lambda[layout_.defects() + k] * car_bus_phi_hessian(problem_.scenario(), x);
           return H;
         },
-        values);
+        rows, cols, values);
   }
 
   void finalize_solution(Ipopt::SolverReturn status, Index, const Number* z, const Number*,

@@ -16,9 +16,13 @@ int KnotHessian::variable(int k, int i) const {
   return i < n_ ? n_ * k + i : n_ * knots_ + m_ * k + (i - n_);
 }
 
-// Within a block, the entries (i, j) with j <= i; the controls come after every state in z, so
-// variable(k, i) >= variable(k, j) there and each triplet is in the lower triangle.
-void KnotHessian::structure(int* rows, int* cols) const {
+// The triplets: within a block, the entries (i, j) with j <= i; the controls come after every
+// state in z, so variable(k, i) >= variable(k, j) there and each triplet is in the lower triangle.
+bool KnotHessian::eval_h(const trajopt::Problem& problem, const double* z, double objective_factor,
+                         const double* multipliers, const ConstraintHessian& constraints, int* rows,
+                         int* cols, double* values) const {
+  if (values != nullptr)
+    return evaluate(problem, z, objective_factor, multipliers, constraints, values);
   int entry = 0;
   for (int k = 0; k < knots_; ++k) {
     const int size = n_ + (k + 1 < knots_ ? m_ : 0);
@@ -30,6 +34,7 @@ void KnotHessian::structure(int* rows, int* cols) const {
       }
     }
   }
+  return true;
 }
 
 namespace {
@@ -50,7 +55,7 @@ Eigen::MatrixXd cost_block(const trajopt::CostExpansion& cost, double objective_
 }  // namespace
 
 bool KnotHessian::evaluate(const trajopt::Problem& problem, const double* z,
-                           double objective_factor, const double* defect_multipliers,
+                           double objective_factor, const double* multipliers,
                            const ConstraintHessian& constraints, double* values) const {
   std::fill(values, values + nonzeros(), 0.0);
   for (int k = 0; k < knots_; ++k) {
@@ -62,8 +67,7 @@ bool KnotHessian::evaluate(const trajopt::Problem& problem, const double* z,
     Eigen::MatrixXd block =
         cost_block(last ? problem.terminal_cost(x) : problem.stage_cost(k, x, u), objective_factor);
     if (!last) {
-      const Eigen::Map<const Eigen::VectorXd> defect(defect_multipliers + std::ptrdiff_t{n_} * k,
-                                                     n_);
+      const Eigen::Map<const Eigen::VectorXd> defect(multipliers + std::ptrdiff_t{n_} * k, n_);
       block += problem.dynamics_hessian(x, u, -defect);
     }
     block += constraints(k, x, u);

@@ -154,11 +154,7 @@ class ProblemNlp : public Ipopt::TNLP {
   // -f(x_k, u_k) weighted by its multipliers, and the knot's constraints weighted by theirs.
   bool eval_h(Index, const Number* z, bool, Number obj_factor, Index, const Number* lambda, bool,
               Index, Index* rows, Index* cols, Number* values) override {
-    if (values == nullptr) {
-      hessian_.structure(rows, cols);
-      return true;
-    }
-    return hessian_.evaluate(
+    return hessian_.eval_h(
         problem_, z, obj_factor, lambda,
         [&](int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u) -> Eigen::MatrixXd {
           const auto s = static_cast<std::size_t>(k);
@@ -166,7 +162,7 @@ class ProblemNlp : public Ipopt::TNLP {
           return problem_.constraint_hessian(
               k, x, u, Eigen::Map<const Eigen::VectorXd>(lambda + row_start_[s], rows_[s]));
         },
-        values);
+        rows, cols, values);
   }
 
   void finalize_solution(Ipopt::SolverReturn status, Index, const Number* z, const Number*,
