@@ -19,35 +19,9 @@ Eigen::Vector4d rotate_gradient(const Eigen::Vector4d& q, const Eigen::Vector3d&
   return detail::UnitQuaternion(q).rotate_gradient(v, w);
 }
 
-// For unit q = (s, v), Q(q) u = (s^2 - |v|^2) u + 2 (v . u) v + 2 s (v x u), so w . Q(q) u is the
-// quadratic form q' M q with
-//   M = [ w . u      (u x w)'                  ]
-//       [ u x w      u w' + w u' - (w . u) I3  ],
-// and for any nonzero q, G(q) = w . Q(q / |q|) u = q' M q / q' q (degree 0). Its derivatives:
-//   grad G = 2 (M q - G q) / |q|^2,
-//   hess G = (2 M - 2 G I4 - 2 q grad' - 2 grad q') / |q|^2.
-// Written with the unit n = q / |q| and g = 2 (M n - G n) (= |q| grad G):
-//   hess G = (2 M - 2 G I4 - 2 n g' - 2 g n') / |q|^2.
-// Forming q' M q itself would overflow: |q| may reach ~1e100 and M ~1e200 in an accepted scene
-// (fuzz_proximity: a quaternion of norm 1e70 gave NaN); with n every product stays within M's
-// size, and only the final division carries |q| (>= 1e-40 by Pose, so at most ~1e282).
 Eigen::Matrix4d rotate_hessian(const Eigen::Vector4d& q, const Eigen::Vector3d& v,
                                const Eigen::Vector3d& w) {
-  Eigen::Matrix4d M;
-  const Eigen::Vector3d v_cross_w = v.cross(w);
-  M(0, 0) = w.dot(v);
-  M.block<1, 3>(0, 1) = v_cross_w.transpose();
-  M.block<3, 1>(1, 0) = v_cross_w;
-  M.block<3, 3>(1, 1) =
-      v * w.transpose() + w * v.transpose() - w.dot(v) * Eigen::Matrix3d::Identity();
-  const double norm = q.norm();
-  const Eigen::Vector4d unit = q / norm;
-  const Eigen::Vector4d M_unit = M * unit;
-  const double value = unit.dot(M_unit);
-  const Eigen::Vector4d g = 2.0 * (M_unit - value * unit);
-  return (2.0 * M - 2.0 * value * Eigen::Matrix4d::Identity() - 2.0 * unit * g.transpose() -
-          2.0 * g * unit.transpose()) /
-         (norm * norm);
+  return detail::UnitQuaternion(q).rotate_hessian(v, w);
 }
 
 Eigen::Matrix<double, 3, 4> rotate_transpose_jacobian(const Eigen::Vector4d& q,

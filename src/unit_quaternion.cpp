@@ -14,7 +14,8 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& u) {
 // (e.g. Q00 = 1 - 2 (y^2 + z^2), Q01 = 2 (x y - w z)); G = L(q) [0; I3] with
 // L(q) = [w -v'; v w I + [v]x].
 UnitQuaternion::UnitQuaternion(const Eigen::Vector4d& q) {
-  const double inverse_norm = 1.0 / q.norm();  // one square root, one division
+  inverse_norm_ = 1.0 / q.norm();  // one square root, one division
+  const double inverse_norm = inverse_norm_;
   unit_ = q * inverse_norm;
   const double w = unit_(0), x = unit_(1), y = unit_(2), z = unit_(3);
   // Element by element: this runs twice per query, and Eigen's comma initializer costs more.
@@ -46,6 +47,45 @@ Eigen::Matrix<double, 3, 4> UnitQuaternion::rotate_transpose_jacobian(
 Eigen::Vector4d UnitQuaternion::rotate_gradient(const Eigen::Vector3d& u,
                                                 const Eigen::Vector3d& w) const {
   return theta_to_q_ * u.cross(matrix_.transpose() * w);
+}
+
+// For unit q = (s, v), Q(q) u = (s^2 - |v|^2) u + 2 (v . u) v + 2 s (v x u), so w . Q(q) u is the
+// quadratic form q' M q with
+//   M = [ w . u      (u x w)'                  ]
+//       [ u x w      u w' + w u' - (w . u) I3  ],
+// and for any nonzero q, G(q) = w . Q(q / |q|) u = q' M q / q' q (degree 0). Its derivatives:
+//   grad G = 2 (M q - G q) / |q|^2,
+//   hess G = (2 M - 2 G I4 - 2 q grad' - 2 grad q') / |q|^2.
+// Written with the unit n = q / |q| and g = 2 (M n - G n) (= |q| grad G):
+//   hess G = (2 M - 2 G I4 - 2 n g' - 2 g n') / |q|^2.
+// Forming q' M q itself would overflow: |q| may reach ~1e100 and M ~1e200 in an accepted scene
+// (fuzz_proximity: a quaternion of norm 1e70 gave NaN); with n every product stays within M's
+// size, and only the final factor carries |q| (1 / |q|^2 within [1e-200, 1e80], as Pose keeps
+// |q| within [1e-40, 1e100]). Only the lower triangle is computed, then mirrored: exactly
+// symmetric.
+Eigen::Matrix4d UnitQuaternion::rotate_hessian(const Eigen::Vector3d& u,
+                                               const Eigen::Vector3d& w) const {
+  const double u_dot_w = u.dot(w);
+  const Eigen::Vector3d u_cross_w = u.cross(w);
+  Eigen::Matrix4d M;
+  M(0, 0) = u_dot_w;
+  for (int i = 0; i < 3; ++i) {
+    M(i + 1, 0) = M(0, i + 1) = u_cross_w(i);
+    for (int j = 0; j <= i; ++j) M(i + 1, j + 1) = M(j + 1, i + 1) = u(i) * w(j) + w(i) * u(j);
+    M(i + 1, i + 1) -= u_dot_w;
+  }
+  const Eigen::Vector4d M_unit = M * unit_;
+  const double value = unit_.dot(M_unit);
+  const Eigen::Vector4d g = 2.0 * (M_unit - value * unit_);
+  const double factor = 2.0 * inverse_norm_ * inverse_norm_;
+  Eigen::Matrix4d hessian;
+  for (int j = 0; j < 4; ++j) {
+    for (int i = j; i < 4; ++i) {
+      hessian(i, j) = hessian(j, i) = factor * (M(i, j) - unit_(i) * g(j) - g(i) * unit_(j));
+    }
+    hessian(j, j) -= factor * value;
+  }
+  return hessian;
 }
 
 }  // namespace diffpills::detail

@@ -29,11 +29,14 @@ class UnitQuaternion {
   Eigen::Matrix<double, 3, 4> rotate_transpose_jacobian(const Eigen::Vector3d& v) const;
   // d/dq [ w . Q(q / |q|) u ]: w' rotate_jacobian(u), without forming the Jacobian.
   Eigen::Vector4d rotate_gradient(const Eigen::Vector3d& u, const Eigen::Vector3d& w) const;
+  // d^2/dq^2 [ w . Q(q / |q|) u ] (4x4, exactly symmetric).
+  Eigen::Matrix4d rotate_hessian(const Eigen::Vector3d& u, const Eigen::Vector3d& w) const;
 
  private:
   // 2 G(qhat) / |q|, the map from d/dtheta to d/dq.
   Eigen::Matrix<double, 4, 3> theta_to_q_;
   Eigen::Vector4d unit_;
+  double inverse_norm_ = 1.0;  // 1 / |q|
   Eigen::Matrix3d matrix_;
 };
 

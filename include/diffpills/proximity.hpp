@@ -114,7 +114,7 @@ struct ProximityJacobian : Proximity {
 // symmetric. Exact where phi is twice differentiable (unique closest points, strict
 // complementarity); elsewhere the derivative of the reported gradient along the closest points'
 // reported Jacobians (one of the one-sided choices); 0 where the cores intersect (phi is flat
-// there). Derivation in src/proximity/measure_hessian.hpp.
+// there). Derivation in src/proximity/phi_hessian.hpp.
 struct ProximityHessian : ProximityJacobian {
   Eigen::Matrix<double, 14, 14> hessian = Eigen::Matrix<double, 14, 14>::Zero();
 };

@@ -1,5 +1,6 @@
-// The Hessian of a measure of two cores' witness points (phi, the signed distance) with respect
-// to [r1 q1 r2 q2], from the points' Jacobians (proximity_hessian.cpp, signed_distance.cpp).
+// The Hessian of a measure of two cores' witness points with respect to [r1 q1 r2 q2], from the
+// points' Jacobians: the signed distance's (signed_distance.cpp), apart and in penetration. (phi's
+// own Hessian takes a shorter route from the implicit function theorem's pieces: phi_hessian.hpp.)
 //
 // Both measures have, by the envelope theorem, the gradient
 //

@@ -1,6 +1,7 @@
 #include "pair_result.hpp"
 
 #include "contact_normal.hpp"
+#include "phi_hessian.hpp"
 #include "point_motion.hpp"
 
 namespace diffpills::detail {
@@ -83,12 +84,13 @@ Proximity make_proximity(const PairFrame& frame, const Pose& pose_a, const Posed
   return result;
 }
 
-ProximityJacobian make_proximity_jacobian(const PairFrame& frame, const Pose& pose_a,
-                                          const PosedCore& a, const ClosestFeature& side_a,
-                                          const Pose& pose_b, const PosedCore& b,
-                                          const ClosestFeature& side_b) {
-  ProximityJacobian result;
-  static_cast<Proximity&>(result) = make_proximity(frame, pose_a, a, side_a, pose_b, b, side_b);
+namespace {
+
+// Adds the points' Jacobians to `result`, which holds make_proximity's answer, and returns the
+// points' motion they came from.
+PointMotion add_point_jacobians(const PairFrame& frame, const PosedCore& a,
+                                const ClosestFeature& side_a, const PosedCore& b,
+                                const ClosestFeature& side_b, ProximityJacobian& result) {
   const Eigen::Vector3d p1 = a.r + a.attitude.matrix() * side_a.body_point;
   const Eigen::Vector3d p2 = b.r + b.attitude.matrix() * side_b.body_point;
 
@@ -113,6 +115,32 @@ ProximityJacobian make_proximity_jacobian(const PairFrame& frame, const Pose& po
   }
   point_jacobians(frame.scale, a, b, motion, dnormal, result.core_points_jacobian,
                   result.points_jacobian);
+  return motion;
+}
+
+}  // namespace
+
+ProximityJacobian make_proximity_jacobian(const PairFrame& frame, const Pose& pose_a,
+                                          const PosedCore& a, const ClosestFeature& side_a,
+                                          const Pose& pose_b, const PosedCore& b,
+                                          const ClosestFeature& side_b) {
+  ProximityJacobian result;
+  static_cast<Proximity&>(result) = make_proximity(frame, pose_a, a, side_a, pose_b, b, side_b);
+  add_point_jacobians(frame, a, side_a, b, side_b, result);
+  return result;
+}
+
+ProximityHessian make_proximity_hessian(const PairFrame& frame, const Pose& pose_a,
+                                        const PosedCore& a, const ClosestFeature& side_a,
+                                        const Pose& pose_b, const PosedCore& b,
+                                        const ClosestFeature& side_b) {
+  ProximityHessian result;
+  static_cast<Proximity&>(result) = make_proximity(frame, pose_a, a, side_a, pose_b, b, side_b);
+  const PointMotion motion = add_point_jacobians(frame, a, side_a, b, side_b, result);
+  // Intersecting cores: phi is -(R1 + R2)^2 on a neighbourhood, and the Hessian stays 0.
+  if (!result.cores_intersect) {
+    phi_hessian(frame.scale, a, side_a, b, side_b, motion, result.hessian);
+  }
   return result;
 }
 

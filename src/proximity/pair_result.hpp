@@ -1,5 +1,6 @@
 // From the two sides of a solved pair to the public results: phi, points, normal, gradient
-// (envelope theorem) and, on request, the Jacobians of the points (implicit function theorem).
+// (envelope theorem) and, on request, the Jacobians of the points (implicit function theorem)
+// and phi's Hessian (phi_hessian.hpp).
 // Every solver ends here, so all of them report the same quantities the same way.
 //
 // Everything is computed in the query's frame (pair_frame.hpp) and then brought back to the
@@ -21,5 +22,9 @@ ProximityJacobian make_proximity_jacobian(const PairFrame& frame, const Pose& po
                                           const PosedCore& a, const ClosestFeature& side_a,
                                           const Pose& pose_b, const PosedCore& b,
                                           const ClosestFeature& side_b);
+ProximityHessian make_proximity_hessian(const PairFrame& frame, const Pose& pose_a,
+                                        const PosedCore& a, const ClosestFeature& side_a,
+                                        const Pose& pose_b, const PosedCore& b,
+                                        const ClosestFeature& side_b);
 
 }  // namespace diffpills::detail

@@ -8,23 +8,25 @@ namespace {
 
 // Implicit function theorem with the active set eliminated (posed_core.hpp). Near the
 // solution p_i = r_i + Q_i (u_i + D_i xi_i), and the free coordinates xi = (xi1, xi2) minimize
-// |e|^2, e = p1 - p2, without constraints. With M = [Q1 D1, -Q2 D2] stationarity is M'e = 0;
-// differentiating in a pose coordinate at the solution (xi = 0),
-//   M'M dxi = -(M' de/dpose|_xi + dM'/dpose e),
-//   de/dpose|_xi = dp1|_u - dp2|_u,   dM'/dq_i e = +-D_i' d(Q_i' e)/dq_i   (+ core 1, - core 2).
-// M'M is Z x Z with Z = z1 + z2 <= 4 free coordinates, solved at that fixed size (a template per
-// Z) so that a capsule pair solves 2 x 2, not a padded 4 x 4. Where the closest points are not
-// unique (parallel features) M'M is singular; the pseudo-inverse then gives the minimum-norm
-// motion, eigenvalues below 1e-12 of the largest treated as zero, the relative threshold of the
-// parallel tests. The cheap closed-form inverse serves whenever det(M'M) / prod(diag) > 1e-12,
-// which rules that out.
+// f = |e|^2, e = p1 - p2, without constraints. With M = [Q1 D1, -Q2 D2] stationarity is
+// f_xi / 2 = M'e = 0; differentiating in a pose coordinate at the solution (xi = 0),
+//   M'M dxi = -coupling,   coupling = f_xi,x / 2 = M' de/dx|_xi + dM'/dx e,
+//   de/dx|_xi = dp1|_u - dp2|_u,   dM'/dq_i e = +-D_i' d(Q_i' e)/dq_i   (+ core 1, - core 2).
+// M'M = f_xi,xi / 2 is Z x Z with Z = z1 + z2 <= 4 free coordinates, solved at that fixed size (a
+// template per Z) so that a capsule pair solves 2 x 2, not a padded 4 x 4. Where the closest
+// points are not unique (parallel features) M'M is singular; the pseudo-inverse then gives the
+// minimum-norm motion, eigenvalues below 1e-12 of the largest treated as zero, the relative
+// threshold of the parallel tests. The cheap closed-form inverse serves whenever
+// det(M'M) / prod(diag) > 1e-12, which rules that out.
 template <int Z>
-void add_point_motion_of_size(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
-                              const ClosestFeature& sb, const Eigen::Vector3d& difference,
-                              Matrix3x14& dp1, Matrix3x14& dp2) {
+void add_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
+                      const ClosestFeature& sb, const Eigen::Vector3d& difference,
+                      PointMotion& motion) {
   const int z1 = sa.free_dimensions;
   Eigen::Matrix<double, 3, Z> M;
-  Eigen::Matrix<double, Z, 14> rhs;
+  motion.free = Z;
+  auto coupling = motion.coupling.topRows<Z>();
+  auto dxi = motion.free_motion.topRows<Z>();
   const Eigen::Matrix<double, 3, 4> turn_a = a.attitude.rotate_transpose_jacobian(difference);
   const Eigen::Matrix<double, 3, 4> turn_b = b.attitude.rotate_transpose_jacobian(difference);
   for (int k = 0; k < Z; ++k) {
@@ -33,19 +35,18 @@ void add_point_motion_of_size(const PosedCore& a, const ClosestFeature& sa, cons
         first ? sa.free_directions.col(k) : sb.free_directions.col(k - z1);
     M.col(k) = first ? Eigen::Vector3d(a.attitude.matrix() * direction)
                      : Eigen::Vector3d(-b.attitude.matrix() * direction);
-    rhs.row(k) = -M.col(k).transpose() * (dp1 - dp2);
+    coupling.row(k) = M.col(k).transpose() * (motion.dp1 - motion.dp2);
     if (first) {
-      rhs.row(k).template segment<4>(3) -= direction.transpose() * turn_a;
+      coupling.row(k).template segment<4>(3) += direction.transpose() * turn_a;
     } else {
-      rhs.row(k).template segment<4>(10) += direction.transpose() * turn_b;
+      coupling.row(k).template segment<4>(10) -= direction.transpose() * turn_b;
     }
   }
-  const Eigen::Matrix<double, Z, Z> hessian = M.transpose() * M;
-  Eigen::Matrix<double, Z, 14> dxi;
-  if (hessian.determinant() > 1e-12 * hessian.diagonal().prod()) {
-    dxi = hessian.inverse() * rhs;
+  const Eigen::Matrix<double, Z, Z> curvature = M.transpose() * M;
+  if (curvature.determinant() > 1e-12 * curvature.diagonal().prod()) {
+    dxi.noalias() = -(curvature.inverse() * coupling);
   } else {
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Z, Z>> eigen(hessian);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Z, Z>> eigen(curvature);
     const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
     Eigen::Matrix<double, Z, Z> pseudo_inverse = Eigen::Matrix<double, Z, Z>::Zero();
     for (int k = 0; k < Z; ++k) {
@@ -55,59 +56,67 @@ void add_point_motion_of_size(const PosedCore& a, const ClosestFeature& sa, cons
             eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose() / value;
       }
     }
-    dxi = pseudo_inverse * rhs;
+    dxi.noalias() = -(pseudo_inverse * coupling);
   }
   for (int k = 0; k < Z; ++k) {  // dp1 += Q1 D1 dxi1, dp2 += Q2 D2 dxi2 = -(M's right block) dxi2
-    (k < z1 ? dp1 : dp2) += M.col(k) * dxi.row(k) * (k < z1 ? 1.0 : -1.0);
+    (k < z1 ? motion.dp1 : motion.dp2) += M.col(k) * dxi.row(k) * (k < z1 ? 1.0 : -1.0);
   }
+}
+
+// d p / d[r1 q1 r2 q2] with the body point u held fixed: p = r + Q(q) u, so dp/dr = I and
+// dp/dq = d(Q(q) u)/dq = turn, in the shape's seven columns (column offset 0 or 7).
+void set_fixed_point_jacobian(const Eigen::Matrix<double, 3, 4>& turn, int column,
+                              Matrix3x14& jacobian) {
+  jacobian.setZero();
+  jacobian.block<3, 3>(0, column).setIdentity();
+  jacobian.block<3, 4>(0, column + 3) = turn;
 }
 
 }  // namespace
 
-Matrix3x14 fixed_point_jacobian(const PosedCore& core, const ClosestFeature& side, int column) {
-  Matrix3x14 jacobian = Matrix3x14::Zero();
-  jacobian.block<3, 3>(0, column).setIdentity();
-  jacobian.block<3, 4>(0, column + 3) = core.attitude.rotate_jacobian(side.body_point);
-  return jacobian;
-}
-
-void add_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
-                      const ClosestFeature& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
-                      Matrix3x14& dp2) {
-  switch (sa.free_dimensions + sb.free_dimensions) {
-    case 1:
-      return add_point_motion_of_size<1>(a, sa, b, sb, difference, dp1, dp2);
-    case 2:
-      return add_point_motion_of_size<2>(a, sa, b, sb, difference, dp1, dp2);
-    case 3:
-      return add_point_motion_of_size<3>(a, sa, b, sb, difference, dp1, dp2);
-    case 4:
-      return add_point_motion_of_size<4>(a, sa, b, sb, difference, dp1, dp2);
-    default:
-      return;  // both points fixed (vertices, segment ends, spheres): nothing moves them
-  }
-}
-
 PointMotion core_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
                               const ClosestFeature& sb) {
-  PointMotion motion{fixed_point_jacobian(a, sa, 0), fixed_point_jacobian(b, sb, 7)};
+  PointMotion motion;
+  motion.turn = {a.attitude.rotate_jacobian(sa.body_point),
+                 b.attitude.rotate_jacobian(sb.body_point)};
+  set_fixed_point_jacobian(motion.turn[0], 0, motion.dp1);
+  set_fixed_point_jacobian(motion.turn[1], 7, motion.dp2);
   const Eigen::Vector3d p1 = a.r + a.attitude.matrix() * sa.body_point;
   const Eigen::Vector3d p2 = b.r + b.attitude.matrix() * sb.body_point;
-  add_point_motion(a, sa, b, sb, p1 - p2, motion.dp1, motion.dp2);
+  const Eigen::Vector3d difference = p1 - p2;
+  switch (sa.free_dimensions + sb.free_dimensions) {
+    case 1:
+      add_point_motion<1>(a, sa, b, sb, difference, motion);
+      break;
+    case 2:
+      add_point_motion<2>(a, sa, b, sb, difference, motion);
+      break;
+    case 3:
+      add_point_motion<3>(a, sa, b, sb, difference, motion);
+      break;
+    case 4:
+      add_point_motion<4>(a, sa, b, sb, difference, motion);
+      break;
+    default:  // both points fixed (vertices, segment ends, spheres): nothing moves them
+      break;
+  }
   return motion;
 }
 
+// Column by column: a column of a 6 x 14 matrix is six consecutive doubles, written once, with
+// its unit factor (scale for the quaternion columns) applied on the way.
 void point_jacobians(double scale, const PosedCore& a, const PosedCore& b,
                      const PointMotion& motion, const Matrix3x14& dnormal,
                      Eigen::Matrix<double, 6, 14>& core_points_jacobian,
                      Eigen::Matrix<double, 6, 14>& points_jacobian) {
-  core_points_jacobian.topRows<3>() = motion.dp1;
-  core_points_jacobian.bottomRows<3>() = motion.dp2;
-  points_jacobian.topRows<3>() = motion.dp1 + a.radius * dnormal;
-  points_jacobian.bottomRows<3>() = motion.dp2 - b.radius * dnormal;
-  for (const int column : {3, 10}) {
-    core_points_jacobian.middleCols<4>(column) *= scale;
-    points_jacobian.middleCols<4>(column) *= scale;
+  for (int column = 0; column < 14; ++column) {
+    const bool rotation = (column >= 3 && column < 7) || column >= 10;
+    const double factor = rotation ? scale : 1.0;
+    const Eigen::Vector3d dp1 = factor * motion.dp1.col(column);
+    const Eigen::Vector3d dp2 = factor * motion.dp2.col(column);
+    const Eigen::Vector3d dn = factor * dnormal.col(column);
+    core_points_jacobian.col(column) << dp1, dp2;
+    points_jacobian.col(column) << dp1 + a.radius * dn, dp2 - b.radius * dn;
   }
 }
 

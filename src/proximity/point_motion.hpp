@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 
 #include "posed_core.hpp"
 
@@ -11,22 +12,19 @@ namespace diffpills::detail {
 
 using Matrix3x14 = Eigen::Matrix<double, 3, 14>;
 
-// d p / d[r1 q1 r2 q2] with the body point u held fixed: p = r + Q(q) u, so dp/dr = I and
-// dp/dq = d(Q(q) u)/dq, in the shape's seven columns (column offset 0 or 7).
-Matrix3x14 fixed_point_jacobian(const PosedCore& core, const ClosestFeature& side, int column);
-
-// Adds to dp1, dp2 the motion of the points along their features' free directions: the points
-// are a stationary pair of |p1 - p2|^2 over those directions (closest points, or the witnesses of
-// a facet of the cores' Minkowski difference), and stay one as the poses move. `difference` is
-// p1 - p2.
-void add_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
-                      const ClosestFeature& sb, const Eigen::Vector3d& difference, Matrix3x14& dp1,
-                      Matrix3x14& dp2);
-
-// The motion of the pair's two core points: fixed_point_jacobian of each side plus the motion
-// along their features (add_point_motion).
+// The motion of the pair's two core points. They are a stationary pair of |p1 - p2|^2 over their
+// features' free directions (closest points, or the witnesses of a facet of the cores' Minkowski
+// difference), and stay one as the poses move (point_motion.cpp). With f = |p1 - p2|^2 over the
+// poses x = [r1 q1 r2 q2] and the Z = z1 + z2 free coordinates xi (side 1's first):
 struct PointMotion {
-  Matrix3x14 dp1, dp2;
+  Matrix3x14 dp1, dp2;  // d p_i / dx, the points' total Jacobians
+  // d(Q_i u_i)/dq_i at the fixed body points u_i (3 x 4 each): fixed_point_jacobian's rotation
+  // part.
+  std::array<Eigen::Matrix<double, 3, 4>, 2> turn;
+  // coupling = f_xi,x / 2 and free_motion = dxi/dx = -(f_xi,xi)^+ f_xi,x, Z x 14 each in the
+  // first Z = free rows (the rest unset): the pieces phi's Hessian reuses (phi_hessian.hpp).
+  int free = 0;
+  Eigen::Matrix<double, 4, 14> coupling, free_motion;
 };
 PointMotion core_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
                               const ClosestFeature& sb);

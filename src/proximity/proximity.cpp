@@ -63,7 +63,8 @@ Sides reference_sides(const ShapeA& a, const PosedCore& pa, const ShapeB& b, con
   return sides;
 }
 
-// Result is Proximity or ProximityJacobian; everything but the last step is shared.
+// Result is Proximity, ProximityJacobian or ProximityHessian; everything but the last step is
+// shared.
 template <class Result, class ShapeA, class ShapeB>
 Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& pose_b,
              const ProximityOptions& options) {
@@ -74,7 +75,10 @@ Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& p
   const Sides sides = options.method == Method::kInteriorPoint
                           ? reference_sides(a, posed_a, b, posed_b, frame)
                           : detail::fast_sides(a, posed_a, b, posed_b, frame);
-  if constexpr (std::is_same_v<Result, ProximityJacobian>) {
+  if constexpr (std::is_same_v<Result, ProximityHessian>) {
+    return detail::make_proximity_hessian(frame, pose_a, posed_a, sides[0], pose_b, posed_b,
+                                          sides[1]);
+  } else if constexpr (std::is_same_v<Result, ProximityJacobian>) {
     return detail::make_proximity_jacobian(frame, pose_a, posed_a, sides[0], pose_b, posed_b,
                                            sides[1]);
   } else {
@@ -131,6 +135,15 @@ ProximityJacobian proximity_jacobian(const Shape& a, const Pose& pose_a, const S
   return std::visit(
       [&](const auto& shape_a, const auto& shape_b) {
         return query<ProximityJacobian>(shape_a, pose_a, shape_b, pose_b, options);
+      },
+      a, b);
+}
+
+ProximityHessian proximity_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
+                                   const Pose& pose_b, const ProximityOptions& options) {
+  return std::visit(
+      [&](const auto& shape_a, const auto& shape_b) {
+        return query<ProximityHessian>(shape_a, pose_a, shape_b, pose_b, options);
       },
       a, b);
 }
