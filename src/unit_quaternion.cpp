@@ -60,8 +60,8 @@ Eigen::Vector4d UnitQuaternion::rotate_gradient(const Eigen::Vector3d& u,
 //   hess G = (2 M - 2 G I4 - 2 n g' - 2 g n') / |q|^2.
 // Forming q' M q itself would overflow: |q| may reach ~1e100 and M ~1e200 in an accepted scene
 // (fuzz_proximity: a quaternion of norm 1e70 gave NaN); with n every product stays within M's
-// size, and only the final factor carries |q| (1 / |q|^2 within [1e-200, 1e80], as Pose keeps
-// |q| within [1e-40, 1e100]). Only the lower triangle is computed, then mirrored: exactly
+// size, and only the final factor carries |q| (1 / |q|^2 within [2.5e-201, 1e80], as Pose keeps
+// |q| within [1e-40, 2e100]). Only the lower triangle is computed, then mirrored: exactly
 // symmetric.
 Eigen::Matrix4d UnitQuaternion::rotate_hessian(const Eigen::Vector3d& u,
                                                const Eigen::Vector3d& w) const {

@@ -35,6 +35,13 @@
 //     Shapes far apart compared to their size (a distance V, sizes h) have their closest points
 //     to within the scene's rounding only: beyond V ~ 1e6 h neighbouring candidates' distances
 //     differ by less than the tie tolerance.
+//   - Nearly parallel features that are not parallel by that test (a sine just above 1e-12)
+//     have unique closest points and exact derivatives, computed from cross products of the
+//     features' directions (src/proximity/point_motion.cpp), but the problem is ill-conditioned
+//     there: the points' Jacobians, of size ~1 / sin, carry a relative error of ~eps / sin, and
+//     the Hessian an absolute error of ~eps times the Jacobians' size squared (two segments
+//     twisted by 1e-7: 0.03 on a Hessian of size 4; below a twist of ~1e-8 it is noise).
+//     python/tests/test_near_parallel.py checks both against 50 digits.
 //   - Zero length capsules are spheres.
 //   - Intersecting cores (|p1 - p2| <= 1e-12 of the scene's size): cores_intersect is true,
 //     phi = -(R1 + R2)^2 and its gradient vanishes up to rounding (the proximity is flat there:

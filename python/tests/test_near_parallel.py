@@ -114,3 +114,65 @@ def test_nearly_parallel_capsules_are_backward_stable(theta):
                     worst_gradient = max(worst_gradient, abs(float(exact) - result.gradient[block + k]))
     assert worst_points <= 1e-13 / theta, worst_points
     assert worst_gradient <= 1e-13 / theta, worst_gradient
+
+
+def _exact_poses(a, b):
+    """[r_a, q_a, r_b, q_b] of a pair in 50 digits, the inputs exactly as given."""
+    return [*_exact(a[1]), *_exact(a[2]), *_exact(b[1]), *_exact(b[2])]
+
+
+def _capsules_at(lengths, x):
+    return (lengths[0], x[0:3], x[3:7]), (lengths[1], x[7:10], x[10:14])
+
+
+def _moved(x, steps):
+    """x with steps {coordinate: h} added."""
+    x = list(x)
+    for k, h in steps.items():
+        x[k] += h
+    return x
+
+
+@pytest.mark.parametrize("theta", [1e-3, 1e-5, 1e-7, 1e-9, 1e-11])
+def test_nearly_parallel_jacobian_and_hessian_are_exact(theta):
+    """The points' Jacobian and phi's Hessian where the points are unique, right down to the
+    solvers' parallel threshold (|sin| <= 1e-12): differentiated in 50 digits. (The implicit
+    function theorem's solve once called directions with sines below 1e-6 parallel and gave
+    these pairs the parallel answer, 1e12 off at theta = 1e-6.) The Jacobian, of size ~1 / theta,
+    is held to its own conditioning, 1e-14 / theta of its size. The Hessian is of size 1 here but
+    comes out of terms of the Jacobian's size squared, and is held to the rounding of those:
+    1e-15 |J|^2, an absolute error of ~1e-15 / theta^2 (measured 2e-10 at theta = 1e-3, 0.03 at
+    1e-7, 2e6 at 1e-11: near the threshold the Hessian is noise, as proximity.hpp says)."""
+    rng = np.random.default_rng(100 + round(-np.log10(theta)))
+    for _ in range(2):
+        a, b = _twisted_pair(rng, theta, theta)
+        lengths = (mp.mpf(float(a[0])), mp.mpf(float(b[0])))
+        x = _exact_poses(a, b)
+        result = diffpills.proximity_hessian(
+            diffpills.Capsule(a[0], 0.0), diffpills.Pose(a[1], a[2]),
+            diffpills.Capsule(b[0], 0.0), diffpills.Pose(b[1], b[2]),
+        )  # fmt: skip
+        jacobian = np.zeros((6, 14))
+        for k in range(14):
+            for row in range(6):
+
+                def coordinate(h, k=k, row=row):
+                    points = _closest(*_capsules_at(lengths, _moved(x, {k: h})))
+                    return points[row // 3][row % 3]
+
+                jacobian[row, k] = float(mp.diff(coordinate, 0))
+        hessian = np.zeros((14, 14))
+        for i in range(14):
+            for j in range(i + 1):
+
+                def phi(h, g, i=i, j=j):
+                    steps = {i: h} if i == j else {i: h, j: g}
+                    return _phi(*_capsules_at(lengths, _moved(x, steps)))
+
+                order = (2, 0) if i == j else (1, 1)
+                hessian[i, j] = hessian[j, i] = float(mp.diff(phi, (0, 0), order))
+        jacobian_error = np.abs(result.core_points_jacobian - jacobian).max()
+        hessian_error = np.abs(result.hessian - hessian).max()
+        size = np.abs(jacobian).max()
+        assert jacobian_error <= 1e-14 / theta * size, (jacobian_error, size)
+        assert hessian_error <= 1e-15 * max(size * size, np.abs(hessian).max()), (hessian_error, size)

@@ -1,6 +1,5 @@
 #include "measure_hessian.hpp"
 
-#include "diffpills/rotation.hpp"
 #include "unit_quaternion.hpp"
 
 namespace diffpills::detail {
@@ -30,7 +29,7 @@ Eigen::Matrix<double, 14, 14> measure_hessian(const Pose& pose_a, const Pose& po
     H.middleRows<3>(r) = sign * dw;
     H.middleRows<4>(q) = sign * (rotate.transpose() * dw +
                                  attitude.rotate_transpose_jacobian(w).transpose() * xi_jacobian);
-    H.block<4, 4>(q, q) += sign * rotate_hessian(poses[index]->q(), xi, w);
+    H.block<4, 4>(q, q) += sign * attitude.rotate_hessian(xi, w);
   }
   return 0.5 * (H + H.transpose());
 }

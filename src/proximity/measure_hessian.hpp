@@ -2,7 +2,7 @@
 // points' Jacobians: the signed distance's (signed_distance.cpp), apart and in penetration. (phi's
 // own Hessian takes a shorter route from the implicit function theorem's pieces: phi_hessian.hpp.)
 //
-// Both measures have, by the envelope theorem, the gradient
+// Measures of the witness points (phi, the distance) have, by the envelope theorem, the gradient
 //
 //   g(x) = J_f' w,   J_f = d(P_1 - P_2)/dx at fixed body points xi,   P_i = r_i + Q(q_i) xi_i,
 //
@@ -16,7 +16,7 @@
 //     + rows q1: A_1' dxi_1/dx,  - rows q2: A_2' dxi_2/dx     (the q-gradient's motion with xi)
 //
 // with A_i = d(Q(q_i)' w)/dq_i (3 x 4), since w . Q(q) xi = (Q(q)' w) . xi; the second term uses
-// rotate_hessian (rotation.hpp). H is symmetric where the measure is twice differentiable; the
+// UnitQuaternion::rotate_hessian. H is symmetric where the measure is twice differentiable; the
 // computed one is symmetrized, (H + H') / 2, which removes rounding only.
 #pragma once
 

@@ -1,7 +1,8 @@
 #include "point_motion.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/LU>
+#include <Eigen/Geometry>
+#include <cmath>
 
 namespace diffpills::detail {
 namespace {
@@ -13,11 +14,54 @@ namespace {
 //   M'M dxi = -coupling,   coupling = f_xi,x / 2 = M' de/dx|_xi + dM'/dx e,
 //   de/dx|_xi = dp1|_u - dp2|_u,   dM'/dq_i e = +-D_i' d(Q_i' e)/dq_i   (+ core 1, - core 2).
 // M'M = f_xi,xi / 2 is Z x Z with Z = z1 + z2 <= 4 free coordinates, solved at that fixed size (a
-// template per Z) so that a capsule pair solves 2 x 2, not a padded 4 x 4. Where the closest
-// points are not unique (parallel features) M'M is singular; the pseudo-inverse then gives the
-// minimum-norm motion, eigenvalues below 1e-12 of the largest treated as zero, the relative
-// threshold of the parallel tests. The cheap closed-form inverse serves whenever
-// det(M'M) / prod(diag) > 1e-12, which rules that out.
+// template per Z) so that a capsule pair solves 2 x 2, not a padded 4 x 4.
+//
+// (M'M)^-1 = M^+ M^+' with M^+ = (M'M)^-1 M' the pseudo-inverse of M, which for Z <= 3 has a
+// closed form in cross products (m_k the columns of M, n = m1 x m2):
+//   Z = 1:  M^+ = m1' / |m1|^2
+//   Z = 2:  M^+ = [ (m2 x n)' ; (n x m1)' ] / |n|^2                       (m_j . row k = delta)
+//   Z = 3:  M^+ = M^-1 = [ (m2 x m3)' ; (m3 x m1)' ; (m1 x m2)' ] / (m1 . (m2 x m3))
+// Forming M'M and inverting it instead loses its small eigenvalue: for two unit directions at an
+// angle theta, det(M'M) = 1 - (m1 . m2)^2 = sin^2 theta cancels to nothing below theta ~ 1e-8,
+// while |m1 x m2| = sin theta keeps its digits. The directions are dependent (the closest points
+// not unique) when that sine, |n| / (|m1| |m2|) or |m1 . (m2 x m3)| / (|m1| |m2| |m3|), is at
+// most 1e-12: the very threshold the solvers' parallel tests use, so that the points the solver
+// calls unique get their exact derivatives (an earlier test on det(M'M) / prod(diag) <= 1e-12, a
+// sine of 1e-6, gave twisted segments between the two thresholds the parallel answer, 1e12
+// off). Four free coordinates in three dimensions are always dependent. Dependent directions
+// take the minimum-norm motion: the pseudo-inverse of M'M, eigenvalues below 1e-12 of the
+// largest treated as zero (at a sine below 1e-12 the small eigenvalue, below 1e-24, is rounding).
+template <int Z>
+bool independent_pseudo_inverse(const Eigen::Matrix<double, 3, Z>& M,
+                                Eigen::Matrix<double, Z, 3>& pseudo_inverse) {
+  constexpr double kSine = 1e-12;
+  if constexpr (Z == 1) {
+    const double length2 = M.squaredNorm();
+    if (!(length2 > 0.0)) return false;
+    pseudo_inverse = M.transpose() / length2;
+    return true;
+  } else if constexpr (Z == 2) {
+    const Eigen::Vector3d m1 = M.col(0), m2 = M.col(1);
+    const Eigen::Vector3d n = m1.cross(m2);
+    const double n2 = n.squaredNorm();
+    if (!(n2 > kSine * kSine * m1.squaredNorm() * m2.squaredNorm())) return false;
+    pseudo_inverse.row(0) = m2.cross(n).transpose() / n2;
+    pseudo_inverse.row(1) = n.cross(m1).transpose() / n2;
+    return true;
+  } else if constexpr (Z == 3) {
+    const Eigen::Vector3d m1 = M.col(0), m2 = M.col(1), m3 = M.col(2);
+    const Eigen::Vector3d n = m2.cross(m3);
+    const double volume = m1.dot(n);
+    if (!(std::abs(volume) > kSine * m1.norm() * m2.norm() * m3.norm())) return false;
+    pseudo_inverse.row(0) = n.transpose() / volume;
+    pseudo_inverse.row(1) = m3.cross(m1).transpose() / volume;
+    pseudo_inverse.row(2) = m1.cross(m2).transpose() / volume;
+    return true;
+  } else {
+    return false;
+  }
+}
+
 template <int Z>
 void add_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedCore& b,
                       const ClosestFeature& sb, const Eigen::Vector3d& difference,
@@ -42,10 +86,13 @@ void add_point_motion(const PosedCore& a, const ClosestFeature& sa, const PosedC
       coupling.row(k).template segment<4>(10) -= direction.transpose() * turn_b;
     }
   }
-  const Eigen::Matrix<double, Z, Z> curvature = M.transpose() * M;
-  if (curvature.determinant() > 1e-12 * curvature.diagonal().prod()) {
-    dxi.noalias() = -(curvature.inverse() * coupling);
+  Eigen::Matrix<double, Z, 3> pseudo_inverse_of_M;
+  if (independent_pseudo_inverse<Z>(M, pseudo_inverse_of_M)) {
+    const Eigen::Matrix<double, Z, Z> inverse_curvature =
+        pseudo_inverse_of_M * pseudo_inverse_of_M.transpose();
+    dxi.noalias() = -(inverse_curvature * coupling);
   } else {
+    const Eigen::Matrix<double, Z, Z> curvature = M.transpose() * M;
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Z, Z>> eigen(curvature);
     const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
     Eigen::Matrix<double, Z, Z> pseudo_inverse = Eigen::Matrix<double, Z, Z>::Zero();

@@ -18,8 +18,8 @@ using Matrix3x14 = Eigen::Matrix<double, 3, 14>;
 // poses x = [r1 q1 r2 q2] and the Z = z1 + z2 free coordinates xi (side 1's first):
 struct PointMotion {
   Matrix3x14 dp1, dp2;  // d p_i / dx, the points' total Jacobians
-  // d(Q_i u_i)/dq_i at the fixed body points u_i (3 x 4 each): fixed_point_jacobian's rotation
-  // part.
+  // d(Q_i u_i)/dq_i at the fixed body points u_i (3 x 4 each): the rotation part of the points'
+  // Jacobians with the body points held fixed.
   std::array<Eigen::Matrix<double, 3, 4>, 2> turn;
   // coupling = f_xi,x / 2 and free_motion = dxi/dx = -(f_xi,xi)^+ f_xi,x, Z x 14 each in the
   // first Z = free rows (the rest unset): the pieces phi's Hessian reuses (phi_hessian.hpp).
