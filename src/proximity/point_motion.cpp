@@ -45,17 +45,19 @@ bool independent_pseudo_inverse(const Eigen::Matrix<double, 3, Z>& M,
     const Eigen::Vector3d n = m1.cross(m2);
     const double n2 = n.squaredNorm();
     if (!(n2 > kSine * kSine * m1.squaredNorm() * m2.squaredNorm())) return false;
-    pseudo_inverse.row(0) = m2.cross(n).transpose() / n2;
-    pseudo_inverse.row(1) = n.cross(m1).transpose() / n2;
+    const double inverse = 1.0 / n2;  // one division, not six
+    pseudo_inverse.row(0) = m2.cross(n).transpose() * inverse;
+    pseudo_inverse.row(1) = n.cross(m1).transpose() * inverse;
     return true;
   } else if constexpr (Z == 3) {
     const Eigen::Vector3d m1 = M.col(0), m2 = M.col(1), m3 = M.col(2);
     const Eigen::Vector3d n = m2.cross(m3);
     const double volume = m1.dot(n);
     if (!(std::abs(volume) > kSine * m1.norm() * m2.norm() * m3.norm())) return false;
-    pseudo_inverse.row(0) = n.transpose() / volume;
-    pseudo_inverse.row(1) = m3.cross(m1).transpose() / volume;
-    pseudo_inverse.row(2) = m1.cross(m2).transpose() / volume;
+    const double inverse = 1.0 / volume;
+    pseudo_inverse.row(0) = n.transpose() * inverse;
+    pseudo_inverse.row(1) = m3.cross(m1).transpose() * inverse;
+    pseudo_inverse.row(2) = m1.cross(m2).transpose() * inverse;
     return true;
   } else {
     return false;
