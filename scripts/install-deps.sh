@@ -10,6 +10,7 @@ packages=(
   libgtest-dev           # unit tests
   libbenchmark-dev       # benchmarks
   libfcl-dev             # independent distances for tests and benchmarks
+  libtbb-dev             # oneTBB, measured beside the batches' worker pool in the benchmarks
   nlohmann-json3-dev     # JSON for `diffpills query`
   coinor-libipopt-dev    # NLP cross-check of the trajectory optimizer
   pkg-config             # finds Ipopt

@@ -1,25 +1,23 @@
 #include "diffpills/batch.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <cstdint>
 #include <exception>
 #include <mutex>
-#include <new>
 #include <stdexcept>
 #include <string>
-#include <system_error>
 #include <thread>
-#include <utility>
-#include <vector>
 
 #include "diffpills/signed_distance.hpp"
+#include "worker_pool.hpp"
 
 namespace diffpills {
 namespace {
 
 // "pose.q: ..." from the Pose constructor becomes "q_b[17]: ..." for row 17 of q_b.
-[[noreturn]] void rethrow_for_row(const std::invalid_argument& error, const std::string& side,
-                                  Eigen::Index row) {
+[[noreturn]] void rethrow_for_row(const std::invalid_argument& error, char side, Eigen::Index row) {
   std::string message = error.what();
   const std::string field = message.rfind("pose.r", 0) == 0 ? "r_" : "q_";
   const std::size_t colon = message.find(": ");
@@ -28,7 +26,7 @@ namespace {
 }
 
 Pose pose_at(const Eigen::Ref<const PositionArray>& r, const Eigen::Ref<const QuaternionArray>& q,
-             Eigen::Index row, const std::string& side) {
+             Eigen::Index row, char side) {
   try {
     return Pose(r.row(row).transpose(), q.row(row).transpose());
   } catch (const std::invalid_argument& error) {
@@ -49,15 +47,73 @@ std::exception_ptr with_row(std::exception_ptr error, Eigen::Index row) {
   }
 }
 
-// The batch of either query: row i gets `query(pose_a[i], pose_b[i])`'s value and gradient.
-// `name` and `value_name` are the function's and its output's names, for messages.
-template <class Query>
+// Rows [0, rows) in blocks of block_rows (at most kMaxBlockRows) taken from a shared counter by
+// every thread of the job. fast_rows(begin, end, left) answers what it can of a block and sets
+// left[i - begin] for each row it leaves; row_work(i) computes and writes row i by the scalar
+// path.
+constexpr Eigen::Index kMaxBlockRows = 512;
+
+template <class FastRows, class RowWork>
+struct RowsJob final : detail::Job {
+  RowsJob(const FastRows& fast, const RowWork& work, Eigen::Index rows, Eigen::Index block_rows)
+      : fast_rows(fast),
+        row_work(work),
+        rows(rows),
+        block_rows(block_rows),
+        blocks((rows + block_rows - 1) / block_rows),
+        first_error_row(rows) {}
+
+  // Every exception of a row is caught here and carried to the caller: one escaping a worker
+  // would end the process with std::terminate.
+  void run() noexcept override {
+    std::array<std::uint8_t, kMaxBlockRows> left;
+    for (Eigen::Index block = next_block++; block < blocks; block = next_block++) {
+      const Eigen::Index begin = block * block_rows;
+      const Eigen::Index end = std::min(rows, begin + block_rows);
+      if (begin > first_error_row) return;  // a lower row already failed; the rest is moot
+      fast_rows(begin, end, left.data());
+      for (Eigen::Index i = begin; i < end; ++i) {
+        if (left[static_cast<std::size_t>(i - begin)] == 0) continue;
+        try {
+          row_work(i);
+        } catch (...) {
+          // Every block below a failing row is still processed, so the lowest row recorded is
+          // the first bad row whatever the thread timing.
+          const std::lock_guard<std::mutex> lock(error_mutex);
+          if (i < first_error_row) {
+            first_error_row = i;
+            first_error = with_row(std::current_exception(), i);
+          }
+          break;
+        }
+      }
+    }
+  }
+
+  const FastRows& fast_rows;
+  const RowWork& row_work;
+  const Eigen::Index rows, block_rows, blocks;
+  std::atomic<Eigen::Index> next_block{0};
+  std::atomic<Eigen::Index> first_error_row;
+  std::exception_ptr first_error;  // of first_error_row, written under error_mutex
+  std::mutex error_mutex;
+};
+
+// Leaves every row to the scalar path.
+void no_fast_rows(Eigen::Index begin, Eigen::Index end, std::uint8_t* left) noexcept {
+  std::fill(left, left + (end - begin), std::uint8_t{1});
+}
+
+// The batch of either query: `query(pose_a[i], pose_b[i], i)` writes row i of value and gradient
+// (passed here to check their sizes), for the rows `fast_rows` leaves (RowsJob). `name` and
+// `value_name` are the function's and its output's names, for messages.
+template <class FastRows, class Query>
 void run_batch(const char* name, const char* value_name, const Eigen::Ref<const PositionArray>& r_a,
                const Eigen::Ref<const QuaternionArray>& q_a,
                const Eigen::Ref<const PositionArray>& r_b,
                const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> value,
                Eigen::Ref<GradientArray> gradient, const BatchOptions& options,
-               const Query& query) {
+               const FastRows& fast_rows, const Query& query) {
   const Eigen::Index n = r_a.rows();
   if (q_a.rows() != n || r_b.rows() != n || q_b.rows() != n) {
     throw std::invalid_argument(
@@ -74,64 +130,27 @@ void run_batch(const char* name, const char* value_name, const Eigen::Ref<const 
                                 ")");
   }
 
-  // Threads take blocks of kBlock rows from a shared counter: pair costs vary (a crossing pair
-  // of polygons stops early, a distant one prunes most edge pairs), and a fixed split into one
-  // chunk per thread left one thread idle while the other finished (1.79x on two threads instead
-  // of 1.8-1.9x). Each row is written by exactly one thread; nothing else is shared.
-  constexpr Eigen::Index kBlock = 512;
-  const Eigen::Index blocks = (n + kBlock - 1) / kBlock;
-  // Threads beyond the hardware's only take turns, and threads beyond the blocks find no work, so
-  // a request above either is capped: threads = 10^6 starts no more threads than threads = 0.
+  // Threads take blocks of rows from a shared counter: pair costs vary (a crossing pair of
+  // polygons stops early, a distant one prunes most edge pairs), and a fixed split into one chunk
+  // per thread left one thread idle while the other finished (1.79x on two threads instead of
+  // 1.8-1.9x). Blocks of 512 rows keep the counter cold; a small batch is cut into at least 16
+  // blocks per thread (of at least 16 rows), so that the threads end within a small block of each
+  // other. Each row is written by exactly one thread; nothing else is shared.
   const Eigen::Index hardware = std::max(1u, std::thread::hardware_concurrency());
   const Eigen::Index requested = options.threads == 0 ? hardware : options.threads;
-  const Eigen::Index threads = std::max<Eigen::Index>(1, std::min({requested, hardware, blocks}));
-  std::atomic<Eigen::Index> next_block{0};
-  std::exception_ptr first_error;
-  std::atomic<Eigen::Index> first_error_row{n};
-  std::mutex error_mutex;
-  // Every exception of a row is caught here and carried to the caller: one escaping a thread's
-  // function would end the process with std::terminate.
-  const auto work = [&]() noexcept {
-    for (Eigen::Index block = next_block++; block < blocks; block = next_block++) {
-      const Eigen::Index begin = block * kBlock;
-      const Eigen::Index end = std::min(n, begin + kBlock);
-      if (begin > first_error_row) return;  // a lower row already failed; the rest is moot
-      for (Eigen::Index i = begin; i < end; ++i) {
-        try {
-          const auto single = query(pose_at(r_a, q_a, i, "a"), pose_at(r_b, q_b, i, "b"));
-          value(i) = single.first;
-          gradient.row(i) = single.second.transpose();
-        } catch (...) {
-          // Every block below a failing row is still processed, so the lowest row recorded is
-          // the first bad row whatever the thread timing.
-          const std::lock_guard<std::mutex> lock(error_mutex);
-          if (i < first_error_row) {
-            first_error_row = i;
-            first_error = with_row(std::current_exception(), i);
-          }
-          break;
-        }
-      }
-    }
+  const auto row_work = [&](Eigen::Index i) {
+    query(pose_at(r_a, q_a, i, 'a'), pose_at(r_b, q_b, i, 'b'), i);
   };
-  // The calling thread works beside threads - 1 helpers. A helper the system refuses (no thread
-  // or no memory for its stack left) is not an error: the rows do not depend on which thread
-  // computes them, so the batch goes on with the helpers that did start, or with the caller
-  // alone. work() throws nothing, so every started helper is joined before this returns.
-  std::vector<std::thread> helpers;
-  helpers.reserve(static_cast<std::size_t>(threads - 1));
-  for (Eigen::Index t = 1; t < threads; ++t) {
-    try {
-      helpers.emplace_back(work);
-    } catch (const std::system_error&) {
-      break;
-    } catch (const std::bad_alloc&) {
-      break;
-    }
-  }
-  work();
-  for (std::thread& helper : helpers) helper.join();
-  if (first_error) std::rethrow_exception(first_error);
+  RowsJob<FastRows, decltype(row_work)> job(
+      fast_rows, row_work, n, std::clamp<Eigen::Index>(n / (16 * hardware), 16, kMaxBlockRows));
+  // Threads beyond the hardware's only take turns, and threads beyond the blocks find no work, so
+  // a request above either is capped: threads = 10^6 uses no more threads than threads = 0.
+  const Eigen::Index threads =
+      std::max<Eigen::Index>(1, std::min({requested, hardware, job.blocks}));
+  // The calling thread works beside threads - 1 of the process's workers (worker_pool.hpp: started
+  // once, reused by every call; a worker the system refuses is one fewer, never an error).
+  detail::WorkerPool::instance().run(job, static_cast<int>(threads - 1));
+  if (job.first_error) std::rethrow_exception(job.first_error);
 }
 
 }  // namespace
@@ -142,10 +161,11 @@ void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
                      const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> phi,
                      Eigen::Ref<GradientArray> gradient, const BatchOptions& options) {
   const ProximityOptions single{options.method};
-  run_batch("proximity_batch", "phi", r_a, q_a, r_b, q_b, phi, gradient, options,
-            [&](const Pose& pose_a, const Pose& pose_b) {
+  run_batch("proximity_batch", "phi", r_a, q_a, r_b, q_b, phi, gradient, options, no_fast_rows,
+            [&](const Pose& pose_a, const Pose& pose_b, Eigen::Index i) {
               const Proximity result = proximity(a, pose_a, b, pose_b, single);
-              return std::make_pair(result.phi, result.gradient);
+              phi(i) = result.phi;
+              gradient.row(i) = result.gradient.transpose();
             });
 }
 
@@ -156,9 +176,10 @@ void signed_distance_batch(const Shape& a, const Eigen::Ref<const PositionArray>
                            Eigen::Ref<Eigen::VectorXd> distance, Eigen::Ref<GradientArray> gradient,
                            const BatchOptions& options) {
   run_batch("signed_distance_batch", "distance", r_a, q_a, r_b, q_b, distance, gradient, options,
-            [&](const Pose& pose_a, const Pose& pose_b) {
+            no_fast_rows, [&](const Pose& pose_a, const Pose& pose_b, Eigen::Index i) {
               const SignedDistance result = signed_distance(a, pose_a, b, pose_b);
-              return std::make_pair(result.distance, result.gradient);
+              distance(i) = result.distance;
+              gradient.row(i) = result.gradient.transpose();
             });
 }
 

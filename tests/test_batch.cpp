@@ -1,13 +1,21 @@
 // proximity_batch: every entry equals the single call, for every pair type and thread count (any
 // count, however large, and also when the system refuses threads); bad rows are reported by index.
+// The threads are the process's worker pool: reused across calls, shared by callers on several
+// threads, and started anew in a forked child.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <climits>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "diffpills/diffpills.hpp"
 #include "support/random_shapes.hpp"
@@ -215,6 +223,104 @@ TEST(Batch, GoesOnWithTheCallingThreadWhenNoThreadStarts) {
   if (kSanitized) GTEST_SKIP() << "address-space limit under a sanitizer";
   // No room for any thread's stack: the calling thread computes every row.
   for (int threads : {0, 2, 1'000'000}) expect_batch_within_address_space(1 << 20, threads);
+}
+
+// The ids of the process's threads (the entries of /proc/self/task).
+std::set<std::string> thread_ids() {
+  std::set<std::string> ids;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/task")) {
+    ids.insert(entry.path().filename().string());
+  }
+  return ids;
+}
+
+TEST(Batch, ReusesItsThreadsAcrossCalls) {
+  // Issue 13: no thread is created per call. A two-thread batch starts the process's worker (if
+  // an earlier test has not), which outlives the call; a hundred more batches of every size run on the same threads
+  // (the same thread ids before and after: a thread started and joined per call, as before this
+  // pool, would leave no worker behind after the first call).
+  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one hardware thread: no workers";
+  Rng rng(66);
+  const Shape capsule = random_capsule(rng, 1.0).shape;
+  const Arrays arrays = random_arrays(rng, 4'000);
+  Eigen::VectorXd phi(4'000);
+  GradientArray gradient(4'000, 14);
+  proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b, phi, gradient,
+                  {2});
+  const std::set<std::string> after_first = thread_ids();
+  EXPECT_GE(after_first.size(), 2u) << "no worker outlived the first batch";
+  for (int call = 0; call < 100; ++call) {
+    const Eigen::Index rows = 1 + (call * 397) % 4'000;
+    proximity_batch(capsule, arrays.r_a.topRows(rows), arrays.q_a.topRows(rows), capsule,
+                    arrays.r_b.topRows(rows), arrays.q_b.topRows(rows), phi.head(rows),
+                    gradient.topRows(rows), {call % 2 == 0 ? 2 : 0});
+    ASSERT_TRUE(
+        equals_single_calls(capsule, capsule, arrays, phi.head(rows), gradient.topRows(rows)))
+        << "call " << call << ", " << rows << " rows";
+  }
+  EXPECT_EQ(thread_ids(), after_first);
+}
+
+TEST(Batch, CallersOnSeveralThreadsAtOnceGetTheSingleCalls) {
+  // The pool serves one batch at a time; a batch started while another runs computes on its own
+  // thread. Four threads each run forty batches at once, with two threads asked each time.
+  Rng rng(67);
+  const Shape a = random_capsule(rng, 1.0).shape;
+  const Shape b = random_polygon(rng, 1.0).shape;
+  const Arrays arrays = random_arrays(rng, 3'000);
+  std::vector<int> all_equal(4, 0);
+  std::vector<std::thread> callers;
+  for (int t = 0; t < 4; ++t) {
+    callers.emplace_back([&, t] {
+      Eigen::VectorXd phi(3'000);
+      GradientArray gradient(3'000, 14);
+      int equal = 0;
+      for (int call = 0; call < 40; ++call) {
+        proximity_batch(a, arrays.r_a, arrays.q_a, b, arrays.r_b, arrays.q_b, phi, gradient, {2});
+        equal += equals_single_calls(a, b, arrays, phi, gradient) ? 1 : 0;
+      }
+      all_equal[static_cast<std::size_t>(t)] = equal;
+    });
+  }
+  for (std::thread& caller : callers) caller.join();
+  for (int t = 0; t < 4; ++t)
+    EXPECT_EQ(all_equal[static_cast<std::size_t>(t)], 40) << "caller " << t;
+}
+
+TEST(Batch, AForkedChildStartsItsOwnWorkers) {
+  // fork copies only the calling thread: the parent's worker does not exist in the child. A pool
+  // that waited for it would hang (what an OpenMP region does in the forked child of a process
+  // that used libgomp's threads, measured with g++ 12); one that only counted on it would run on
+  // one thread. The child must answer, in time, and start a worker of its own (exit status 2 if
+  // it did not).
+  Rng rng(68);
+  const Shape capsule = random_capsule(rng, 1.0).shape;
+  const Arrays arrays = random_arrays(rng, 20'000);
+  Eigen::VectorXd phi(20'000);
+  GradientArray gradient(20'000, 14);
+  proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b, phi, gradient,
+                  {2});
+  std::fflush(nullptr);
+  const pid_t child = fork();
+  ASSERT_NE(child, -1);
+  if (child == 0) {
+    alarm(60);  // a hang ends the child with SIGALRM
+    phi.setZero();
+    proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b, phi, gradient,
+                    {2});
+    if (!equals_single_calls(capsule, capsule, arrays, phi, gradient)) _exit(1);
+    // The child's own worker (the parent's copy lists one that is not there).
+    const bool parallel = std::thread::hardware_concurrency() < 2 || thread_ids().size() > 1;
+    _exit(parallel ? 0 : 2);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "the child was killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  // And the parent's pool still works.
+  proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b, phi, gradient,
+                  {2});
+  EXPECT_TRUE(equals_single_calls(capsule, capsule, arrays, phi, gradient));
 }
 
 TEST(Batch, RejectsMismatchedArraysAndBadThreadCounts) {

@@ -12,10 +12,14 @@ namespace diffpills {
 
 struct BatchOptions {
   // Threads working on the batch, the calling thread included; 0 = every hardware thread. Capped
-  // at the hardware threads and at one per 512-row block (more would only wait), so any count is
-  // safe; a negative one throws std::invalid_argument. If the system cannot start a thread, the
-  // batch runs on those that did start (at worst on the calling thread alone) with the same
-  // results: running out of threads is never an error.
+  // at the hardware threads and at what the rows can use (at least 16 rows each), so any count is
+  // safe; a negative one throws std::invalid_argument. The helpers are worker threads the process
+  // starts on first need and reuses for every batch (no thread is started per call; a worker
+  // spins for 0.2 ms after a batch before it sleeps, so that a loop of batches finds it awake).
+  // One batch uses them at a time: a batch called while another runs, from another thread,
+  // computes on its calling thread alone. A forked child starts workers of its own. If the system
+  // cannot start a thread, the batch runs on those that did start (at worst on the calling thread
+  // alone) with the same results: running out of threads is never an error.
   int threads = 0;
   Method method = Method::kDefault;
 };

@@ -1265,8 +1265,8 @@ pose ((3,) or (4,), or one row), used for every row. Returns (phi (N,), gradient
 row equal to proximity(a, Pose(r_a[i], q_a[i]), b, Pose(r_b[i], q_b[i])); N may be 0. Arrays of
 floats or ints of any layout are read (a float64 C-contiguous one in place); complex, bool, str and
 object arrays raise TypeError. threads: an int, 0 = every hardware thread; the calling thread works
-too, and more threads than the hardware's or than 512-row blocks are not started. The GIL is
-released while they run. A bad row raises ValueError naming it, e.g. "q_b[17]: ...".
+too, beside worker threads started once per process and reused by every batch (never more than
+the hardware's, nor than the blocks of rows). The GIL is released while they run. A bad row raises ValueError naming it, e.g. "q_b[17]: ...".
 
 out: optionally (phi, gradient), writable float64 C-contiguous arrays of shapes (N,) and (N, 14),
 sharing no memory with each other or the inputs, to write into and return, for loops that call the batch repeatedly (fresh outputs cost page faults, which

@@ -1,9 +1,10 @@
 """proximity_batch equals single calls row by row, for every pair type, any thread count (also when
-threads cannot start) and broadcast single poses, with 0 rows too; it releases the GIL; every
-object pickles."""
+threads cannot start, and in a forked child) and broadcast single poses, with 0 rows too; it
+releases the GIL; every object pickles."""
 
 import os
 import pickle
+import signal
 import subprocess
 import sys
 import threading
@@ -160,6 +161,31 @@ def test_the_batch_survives_when_threads_cannot_start(headroom, threads):
         timeout=300,
     )
     assert child.returncode == 0, child.stderr
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")
+def test_a_forked_child_gets_the_single_calls_in_time():
+    # A data loader's workers are forked from a process whose batches already started the worker
+    # threads, which the child does not inherit (fork copies only the calling thread). The child's
+    # batch must neither wait for them nor fail: it starts its own.
+    rng = np.random.default_rng(17)
+    a, _ = random_capsule(rng)
+    b, _ = random_polygon(rng)
+    r_a, q_a = random_poses(rng, 20_000)
+    r_b, q_b = random_poses(rng, 20_000)
+    expected, expected_gradient = diffpills.proximity_batch(a, r_a, q_a, b, r_b, q_b, threads=2)
+    child = os.fork()
+    if child == 0:
+        status = 1
+        try:
+            signal.alarm(60)  # a hang ends the child with SIGALRM
+            phi, gradient = diffpills.proximity_batch(a, r_a, q_a, b, r_b, q_b, threads=2)
+            status = 0 if np.array_equal(phi, expected) and np.array_equal(gradient, expected_gradient) else 1
+        finally:
+            os._exit(status)
+    _, status = os.waitpid(child, 0)
+    assert os.WIFEXITED(status), f"the child was killed by signal {os.WTERMSIG(status)}"
+    assert os.WEXITSTATUS(status) == 0
 
 
 @pytest.mark.parametrize("single", ["r_a", "q_a", "r_b", "q_b", "all but r_a"])

@@ -1,0 +1,72 @@
+// The batches' threads: started once per process and reused by every batch call (issue 13),
+// instead of new threads per call (~50-100 us each on this machine's kernel, which at 10^4
+// capsule pairs, ~1 ms of work, was the difference between 1.7x and 1.9x on two threads).
+//
+// Why not OpenMP or oneTBB, the runtimes issue 13 proposed: both are measured beside this pool in
+// bench_proximity (Batch_CapsuleCapsule_OpenMP, _Tbb; BENCHMARKS.md) and scale the same on this
+// machine (1.96-1.98x on two threads at 10^4 capsule pairs). But libgomp ends the process when
+// the system refuses a thread ("Thread creation failed", exit status 1) and hangs in the first
+// parallel region of a forked child (Python's multiprocessing, data-loader workers), both
+// measured with g++ 12; oneTBB copes with both but would be one more runtime library for every
+// program that links diffpills. This pool treats a refused thread as one helper fewer, and a
+// forked child starts workers of its own.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace diffpills::detail {
+
+// A job is a function every participating thread calls once; it must not throw (each thread's
+// exceptions are the job's to catch and carry). The work inside is shared by the job itself
+// (e.g. blocks of rows taken from an atomic counter), so a job done by fewer threads than asked
+// is still done completely.
+class Job {
+ public:
+  virtual void run() noexcept = 0;
+
+ protected:
+  ~Job() = default;
+};
+
+class WorkerPool {
+ public:
+  // The pool of this process (a forked child gets a new one; the parent's workers do not exist
+  // there). Never destroyed: its workers wait until the process ends, so no destructor can race
+  // a batch running while statics are torn down.
+  static WorkerPool& instance();
+
+  // Calls job.run() on the calling thread and on up to helpers workers at once, and returns
+  // when every call has returned. Workers are started on first need, up to helpers; a worker the
+  // system refuses is one helper fewer (tried again by a later call). A worker that wakes only
+  // after the calling thread has finished its own run() is not given the job: the shared work is
+  // then done, and waiting for it would only add its wake-up time. The pool serves one job at a
+  // time: a job submitted while another runs (a batch from a second thread) runs on its calling
+  // thread alone.
+  void run(Job& job, int helpers);
+
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+ private:
+  WorkerPool() = default;
+  ~WorkerPool() = default;
+  void start_workers(int count);
+  void work_loop(std::uint64_t seen);  // seen: the last job it need not take
+
+  std::mutex busy_;  // held by the calling thread of the running job
+  std::mutex state_;
+  std::condition_variable wake_;  // a new job (generation_ moved)
+  std::condition_variable done_;  // a worker left the job (joined_ went down)
+  std::vector<std::thread> workers_;
+  Job* job_ = nullptr;
+  std::atomic<std::uint64_t> generation_{0};  // moved under state_, read while spinning
+  int wanted_ = 0;                            // workers the current job may still take
+  int joined_ = 0;                            // workers inside the current job's run()
+};
+
+}  // namespace diffpills::detail
