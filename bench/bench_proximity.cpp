@@ -10,6 +10,7 @@
 #include <fcl/geometry/shape/capsule.h>
 #include <fcl/geometry/shape/convex.h>
 #include <fcl/narrowphase/distance.h>
+#include <hwy/targets.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -356,15 +357,23 @@ const BatchPoses& batch_poses(Eigen::Index count) {
   return found->second;
 }
 
-void run_batch(benchmark::State& state, const Shape& a, const Shape& b) {
+// proximity_batch, or signed_distance_batch (its other measure), over the first argument's rows.
+enum class Measure { kPhi, kSignedDistance };
+
+void run_batch(benchmark::State& state, const Shape& a, const Shape& b,
+               Measure measure = Measure::kPhi) {
   const Eigen::Index count = state.range(0);
   const BatchPoses& p = batch_poses(count);
   const BatchOptions options{static_cast<int>(state.range(1))};
-  Eigen::VectorXd phi(count);
+  Eigen::VectorXd value(count);
   GradientArray gradient(count, 14);
   for (auto _ : state) {
-    proximity_batch(a, p.r_a, p.q_a, b, p.r_b, p.q_b, phi, gradient, options);
-    benchmark::DoNotOptimize(phi.data());
+    if (measure == Measure::kPhi) {
+      proximity_batch(a, p.r_a, p.q_a, b, p.r_b, p.q_b, value, gradient, options);
+    } else {
+      signed_distance_batch(a, p.r_a, p.q_a, b, p.r_b, p.q_b, value, gradient, options);
+    }
+    benchmark::DoNotOptimize(value.data());
   }
   state.SetItemsProcessed(state.iterations() * count);
 }
@@ -395,6 +404,34 @@ void Batch_CapsuleCapsule_PythonPoses(benchmark::State& state) {
     benchmark::DoNotOptimize(phi.data());
   }
   state.SetItemsProcessed(state.iterations() * kCount);
+}
+
+// signed_distance_batch of the same capsule rows (the vector kernel's other measure).
+void Batch_CapsuleCapsule_SignedDistance(benchmark::State& s) {
+  run_batch(s, kCapsuleA, kCapsuleB, Measure::kSignedDistance);
+}
+
+// The capsule batch on one thread with the vector kernel held to each instruction set this CPU
+// runs (Highway's targets, widest first: the argument indexes them), labelled with its name.
+void Batch_CapsuleCapsule_InstructionSet(benchmark::State& state) {
+  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  const auto index = static_cast<std::size_t>(state.range(0));
+  if (index >= targets.size()) {
+    state.SkipWithError("no such instruction set here");
+    return;
+  }
+  hwy::SetSupportedTargetsForTest(targets[index]);
+  state.SetLabel(hwy::TargetName(targets[index]));
+  const Eigen::Index count = 100000;
+  const BatchPoses& p = batch_poses(count);
+  Eigen::VectorXd phi(count);
+  GradientArray gradient(count, 14);
+  for (auto _ : state) {
+    proximity_batch(kCapsuleA, p.r_a, p.q_a, kCapsuleB, p.r_b, p.q_b, phi, gradient, {1});
+    benchmark::DoNotOptimize(phi.data());
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  state.SetItemsProcessed(state.iterations() * count);
 }
 
 // The same rows split by OpenMP (libgomp, dynamic schedule) and by oneTBB (parallel_for over
@@ -447,6 +484,14 @@ void Batch_CapsuleCapsule_Tbb(benchmark::State& state) {
 
 BENCHMARK(Batch_CapsuleCapsule)
     ->ArgsProduct({{10000, 100000, 1000000}, {1, 2}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(Batch_CapsuleCapsule_SignedDistance)
+    ->ArgsProduct({{10000, 1000000}, {1, 2}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(Batch_CapsuleCapsule_InstructionSet)
+    ->DenseRange(0, 4)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(Batch_CapsuleCapsule_OpenMP)

@@ -7,6 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake
   libeigen3-dev          # linear algebra
+  libhwy-dev             # Google Highway: SIMD with run-time dispatch (the capsule batches)
   libgtest-dev           # unit tests
   libbenchmark-dev       # benchmarks
   libfcl-dev             # independent distances for tests and benchmarks

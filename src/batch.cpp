@@ -6,10 +6,13 @@
 #include <cstdint>
 #include <exception>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <variant>
 
+#include "capsule_rows.hpp"
 #include "diffpills/signed_distance.hpp"
 #include "worker_pool.hpp"
 
@@ -48,10 +51,11 @@ std::exception_ptr with_row(std::exception_ptr error, Eigen::Index row) {
 }
 
 // Rows [0, rows) in blocks of block_rows (at most kMaxBlockRows) taken from a shared counter by
-// every thread of the job. fast_rows(begin, end, left) answers what it can of a block and sets
-// left[i - begin] for each row it leaves; row_work(i) computes and writes row i by the scalar
-// path.
+// every thread of the job. fast_rows(begin, end, left) answers what it can of a block (the
+// capsule pairs' vector kernel, capsule_rows.hpp) and sets left[i - begin] for each row it leaves;
+// row_work(i) computes and writes row i by the scalar path.
 constexpr Eigen::Index kMaxBlockRows = 512;
+static_assert(kMaxBlockRows <= detail::kCapsuleRowsBlock);
 
 template <class FastRows, class RowWork>
 struct RowsJob final : detail::Job {
@@ -99,9 +103,21 @@ struct RowsJob final : detail::Job {
   std::mutex error_mutex;
 };
 
-// Leaves every row to the scalar path.
+// Leaves every row to the scalar path (pairs the vector kernel does not cover).
 void no_fast_rows(Eigen::Index begin, Eigen::Index end, std::uint8_t* left) noexcept {
   std::fill(left, left + (end - begin), std::uint8_t{1});
+}
+
+// The vector kernel's pair if both shapes are capsules it covers (capsule_rows_apply).
+std::optional<detail::CapsulePair> capsule_pair(const Shape& a, const Shape& b,
+                                                detail::CapsuleMeasure measure) {
+  const auto* capsule_a = std::get_if<Capsule>(&a);
+  const auto* capsule_b = std::get_if<Capsule>(&b);
+  if (capsule_a == nullptr || capsule_b == nullptr) return std::nullopt;
+  const detail::CapsulePair pair{capsule_a->length(), capsule_a->radius(), capsule_b->length(),
+                                 capsule_b->radius(), measure};
+  if (!detail::capsule_rows_apply(pair)) return std::nullopt;
+  return pair;
 }
 
 // The batch of either query: `query(pose_a[i], pose_b[i], i)` writes row i of value and gradient
@@ -161,7 +177,15 @@ void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
                      const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> phi,
                      Eigen::Ref<GradientArray> gradient, const BatchOptions& options) {
   const ProximityOptions single{options.method};
-  run_batch("proximity_batch", "phi", r_a, q_a, r_b, q_b, phi, gradient, options, no_fast_rows,
+  // Two capsules by the default method: the vector kernel first, the scalar path for the rest.
+  const auto capsules = options.method == Method::kDefault
+                            ? capsule_pair(a, b, detail::CapsuleMeasure::kPhi)
+                            : std::nullopt;
+  const auto fast_rows = [&](Eigen::Index begin, Eigen::Index end, std::uint8_t* left) noexcept {
+    if (!capsules) return no_fast_rows(begin, end, left);
+    detail::capsule_rows(*capsules, r_a, q_a, r_b, q_b, begin, end, phi, gradient, left);
+  };
+  run_batch("proximity_batch", "phi", r_a, q_a, r_b, q_b, phi, gradient, options, fast_rows,
             [&](const Pose& pose_a, const Pose& pose_b, Eigen::Index i) {
               const Proximity result = proximity(a, pose_a, b, pose_b, single);
               phi(i) = result.phi;
@@ -175,8 +199,13 @@ void signed_distance_batch(const Shape& a, const Eigen::Ref<const PositionArray>
                            const Eigen::Ref<const QuaternionArray>& q_b,
                            Eigen::Ref<Eigen::VectorXd> distance, Eigen::Ref<GradientArray> gradient,
                            const BatchOptions& options) {
+  const auto capsules = capsule_pair(a, b, detail::CapsuleMeasure::kSignedDistance);
+  const auto fast_rows = [&](Eigen::Index begin, Eigen::Index end, std::uint8_t* left) noexcept {
+    if (!capsules) return no_fast_rows(begin, end, left);
+    detail::capsule_rows(*capsules, r_a, q_a, r_b, q_b, begin, end, distance, gradient, left);
+  };
   run_batch("signed_distance_batch", "distance", r_a, q_a, r_b, q_b, distance, gradient, options,
-            no_fast_rows, [&](const Pose& pose_a, const Pose& pose_b, Eigen::Index i) {
+            fast_rows, [&](const Pose& pose_a, const Pose& pose_b, Eigen::Index i) {
               const SignedDistance result = signed_distance(a, pose_a, b, pose_b);
               distance(i) = result.distance;
               gradient.row(i) = result.gradient.transpose();

@@ -54,6 +54,33 @@ void WorkerPool::start_workers(int count) {
   }
 }
 
+namespace {
+// A spin-wait hint: lets the core run its sibling hyperthread and saves power while spinning.
+void pause_while_spinning() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#else
+  std::this_thread::yield();
+#endif
+}
+
+// Waiting by spinning, for at most 0.2 ms, before a thread sleeps on a condition variable. Waking
+// a sleeping thread costs a system call and, on a virtual machine, the wake-up of an idle virtual
+// CPU: measured here 16-30 us when the other CPU was recently busy and up to 2.7 ms when it had
+// halted, against 60-650 us of work per thread for 10^4 capsule pairs on two threads (vector
+// kernel or scalar path). Returns whether `done` became true.
+template <class Done>
+bool spin_until(const Done& done) {
+  constexpr auto kSpin = std::chrono::microseconds(200);
+  const auto spin_end = std::chrono::steady_clock::now() + kSpin;
+  for (int round = 1; !done(); ++round) {
+    if (round % 16 == 0 && std::chrono::steady_clock::now() > spin_end) return false;
+    pause_while_spinning();
+  }
+  return true;
+}
+}  // namespace
+
 void WorkerPool::run(Job& job, int helpers) {
   std::unique_lock<std::mutex> busy(busy_, std::try_to_lock);
   if (!busy.owns_lock() || helpers <= 0) {
@@ -70,38 +97,27 @@ void WorkerPool::run(Job& job, int helpers) {
   }
   wake_.notify_all();
   job.run();
-  std::unique_lock<std::mutex> lock(state_);
-  wanted_ = 0;  // late wakers stay out: the work is done or in the hands of those inside
-  done_.wait(lock, [this] { return joined_ == 0; });
+  {
+    const std::lock_guard<std::mutex> lock(state_);
+    wanted_ = 0;  // late wakers stay out: the work is done or in the hands of those inside
+  }
+  // The helpers inside are finishing their last block: wait for them awake, as they do for jobs.
+  const auto helpers_done = [this] { return joined_.load(std::memory_order_acquire) == 0; };
+  if (!spin_until(helpers_done)) {
+    std::unique_lock<std::mutex> lock(state_);
+    done_.wait(lock, helpers_done);
+  }
+  const std::lock_guard<std::mutex> lock(state_);
   job_ = nullptr;
 }
 
-namespace {
-// A spin-wait hint: lets the core run its sibling hyperthread and saves power while spinning.
-void pause_while_spinning() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#else
-  std::this_thread::yield();
-#endif
-}
-}  // namespace
-
-// Between jobs a worker first spins, watching generation_, for kSpin before it sleeps on the
-// condition variable. Waking a sleeping thread costs a system call and, on a virtual machine, the
-// wake-up of an idle virtual CPU: measured here 16-30 us when the other CPU was recently busy and
-// up to 2.7 ms when it had halted, against ~0.65 ms of work per thread for 10^4 capsule pairs on
-// two threads. A loop calling the batch again within kSpin finds its helpers awake. The price is a
-// worker busy for kSpin after each batch (OpenMP runtimes spin likewise: libgomp 300,000 rounds
-// by default).
+// Between jobs a worker first spins (spin_until), watching generation_, so that a loop calling
+// the batch again within 0.2 ms finds its helpers awake; then it sleeps on the condition variable.
+// The price is a worker busy for 0.2 ms after each batch (OpenMP runtimes spin likewise: libgomp
+// 300,000 rounds by default).
 void WorkerPool::work_loop(std::uint64_t seen) {
-  constexpr auto kSpin = std::chrono::microseconds(200);
   for (;;) {
-    const auto spin_end = std::chrono::steady_clock::now() + kSpin;
-    for (int round = 1; generation_.load(std::memory_order_acquire) == seen; ++round) {
-      if (round % 16 == 0 && std::chrono::steady_clock::now() > spin_end) break;
-      pause_while_spinning();
-    }
+    spin_until([&] { return generation_.load(std::memory_order_acquire) != seen; });
     std::unique_lock<std::mutex> lock(state_);
     wake_.wait(lock, [&] { return generation_.load(std::memory_order_relaxed) != seen; });
     seen = generation_.load(std::memory_order_relaxed);

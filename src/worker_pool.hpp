@@ -66,7 +66,7 @@ class WorkerPool {
   Job* job_ = nullptr;
   std::atomic<std::uint64_t> generation_{0};  // moved under state_, read while spinning
   int wanted_ = 0;                            // workers the current job may still take
-  int joined_ = 0;                            // workers inside the current job's run()
+  std::atomic<int> joined_{0};                // workers inside the job's run(); moved under state_
 };
 
 }  // namespace diffpills::detail

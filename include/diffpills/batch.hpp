@@ -1,6 +1,14 @@
 // Many queries of one shape pair at once: the poses come as arrays, the work is split across
 // threads, and every entry equals the single call proximity(a, pose_a[i], b, pose_b[i]) (or
-// signed_distance(...) for signed_distance_batch).
+// signed_distance(...) for signed_distance_batch). Bit for bit, except for two capsules (by the
+// default method): their rows go through a vector kernel, several pairs per instruction (Google
+// Highway, AVX-512 / AVX2 / SSE4 / plain code chosen at run time; 12-17 ns per pair and thread
+// against ~130 ns), which agrees with the single call to rounding: phi within 1e-12 S^2, the
+// signed distance within 1e-12 S, gradients within the same per length and per unit of q, S the
+// scene's size (the largest of the lengths, the radii's sum and the distance between the
+// capsules' middles). Rows it does not cover (axes within ~5.7 degrees of parallel, cores within
+// 1e-9 S of touching, 1e-2 S for the signed distance, extreme magnitudes, invalid poses) are the
+// single call's.
 #pragma once
 
 #include <Eigen/Core>

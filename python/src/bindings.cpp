@@ -1262,7 +1262,8 @@ gradient (14,) = d phi / d[r_a, q_a, r_b, q_b]. method: "default" or "interior_p
 
 r_a, r_b: (N, 3) positions; q_a, q_b: (N, 4) quaternions [w, x, y, z]. Any of them may be a single
 pose ((3,) or (4,), or one row), used for every row. Returns (phi (N,), gradient (N, 14)), each
-row equal to proximity(a, Pose(r_a[i], q_a[i]), b, Pose(r_b[i], q_b[i])); N may be 0. Arrays of
+row equal to proximity(a, Pose(r_a[i], q_a[i]), b, Pose(r_b[i], q_b[i])) (two capsules: to rounding, 1e-12
+of the scene's size, from a vector kernel; see the C++ header batch.hpp); N may be 0. Arrays of
 floats or ints of any layout are read (a float64 C-contiguous one in place); complex, bool, str and
 object arrays raise TypeError. threads: an int, 0 = every hardware thread; the calling thread works
 too, beside worker threads started once per process and reused by every batch (never more than
