@@ -1,13 +1,14 @@
 // The batches' threads: started once per process and reused by every batch call (issue 13),
-// instead of new threads per call (~50-100 us each on this machine's kernel, which at 10^4
-// capsule pairs, ~1 ms of work, was the difference between 1.7x and 1.9x on two threads).
+// instead of new threads per call, and kept awake by spinning between jobs and at a job's end
+// (worker_pool.cpp): on this virtual machine the wake-up of a sleeping thread, not its creation,
+// held 10^4 capsule pairs at 1.7x on two threads (1.9x with the spinning; BENCHMARKS.md).
 //
 // Why not OpenMP or oneTBB, the runtimes issue 13 proposed: both are measured beside this pool in
 // bench_proximity (Batch_CapsuleCapsule_OpenMP, _Tbb; BENCHMARKS.md) and scale the same on this
-// machine (1.96-1.98x on two threads at 10^4 capsule pairs). But libgomp ends the process when
-// the system refuses a thread ("Thread creation failed", exit status 1) and hangs in the first
-// parallel region of a forked child (Python's multiprocessing, data-loader workers), both
-// measured with g++ 12; oneTBB copes with both but would be one more runtime library for every
+// machine (1.96-1.98x on two threads at 10^4 capsule pairs by the scalar path). But libgomp ends
+// the process when the system refuses a thread ("Thread creation failed", exit status 1) and hangs
+// in the first parallel region of a forked child (Python's multiprocessing, data-loader workers),
+// both measured with g++ 12; oneTBB copes with both but would be one more runtime library for every
 // program that links diffpills. This pool treats a refused thread as one helper fewer, and a
 // forked child starts workers of its own.
 #pragma once
