@@ -103,11 +103,6 @@ struct RowsJob final : detail::Job {
   std::mutex error_mutex;
 };
 
-// Leaves every row to the scalar path (pairs the vector kernel does not cover).
-void no_fast_rows(Eigen::Index begin, Eigen::Index end, std::uint8_t* left) noexcept {
-  std::fill(left, left + (end - begin), std::uint8_t{1});
-}
-
 // The vector kernel's pair if both shapes are capsules it covers (capsule_rows_apply).
 std::optional<detail::CapsulePair> capsule_pair(const Shape& a, const Shape& b,
                                                 detail::CapsuleMeasure measure) {
@@ -120,16 +115,17 @@ std::optional<detail::CapsulePair> capsule_pair(const Shape& a, const Shape& b,
   return pair;
 }
 
-// The batch of either query: `query(pose_a[i], pose_b[i], i)` writes row i of value and gradient
-// (passed here to check their sizes), for the rows `fast_rows` leaves (RowsJob). `name` and
-// `value_name` are the function's and its output's names, for messages.
-template <class FastRows, class Query>
+// The batch of either query: the vector kernel answers what it can of each block if `capsules`
+// holds its pair, and `query(pose_a[i], pose_b[i], i)` writes row i of value and gradient for
+// every other row. `name` and `value_name` are the function's and its output's names, for
+// messages.
+template <class Query>
 void run_batch(const char* name, const char* value_name, const Eigen::Ref<const PositionArray>& r_a,
                const Eigen::Ref<const QuaternionArray>& q_a,
                const Eigen::Ref<const PositionArray>& r_b,
                const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> value,
                Eigen::Ref<GradientArray> gradient, const BatchOptions& options,
-               const FastRows& fast_rows, const Query& query) {
+               const std::optional<detail::CapsulePair>& capsules, const Query& query) {
   const Eigen::Index n = r_a.rows();
   if (q_a.rows() != n || r_b.rows() != n || q_b.rows() != n) {
     throw std::invalid_argument(
@@ -154,10 +150,17 @@ void run_batch(const char* name, const char* value_name, const Eigen::Ref<const 
   // other. Each row is written by exactly one thread; nothing else is shared.
   const Eigen::Index hardware = std::max(1u, std::thread::hardware_concurrency());
   const Eigen::Index requested = options.threads == 0 ? hardware : options.threads;
+  const auto fast_rows = [&](Eigen::Index begin, Eigen::Index end, std::uint8_t* left) noexcept {
+    if (capsules) {
+      detail::capsule_rows(*capsules, r_a, q_a, r_b, q_b, begin, end, value, gradient, left);
+    } else {
+      std::fill(left, left + (end - begin), std::uint8_t{1});  // every row to the scalar path
+    }
+  };
   const auto row_work = [&](Eigen::Index i) {
     query(pose_at(r_a, q_a, i, 'a'), pose_at(r_b, q_b, i, 'b'), i);
   };
-  RowsJob<FastRows, decltype(row_work)> job(
+  RowsJob<decltype(fast_rows), decltype(row_work)> job(
       fast_rows, row_work, n, std::clamp<Eigen::Index>(n / (16 * hardware), 16, kMaxBlockRows));
   // Threads beyond the hardware's only take turns, and threads beyond the blocks find no work, so
   // a request above either is capped: threads = 10^6 uses no more threads than threads = 0.
@@ -181,11 +184,7 @@ void proximity_batch(const Shape& a, const Eigen::Ref<const PositionArray>& r_a,
   const auto capsules = options.method == Method::kDefault
                             ? capsule_pair(a, b, detail::CapsuleMeasure::kPhi)
                             : std::nullopt;
-  const auto fast_rows = [&](Eigen::Index begin, Eigen::Index end, std::uint8_t* left) noexcept {
-    if (!capsules) return no_fast_rows(begin, end, left);
-    detail::capsule_rows(*capsules, r_a, q_a, r_b, q_b, begin, end, phi, gradient, left);
-  };
-  run_batch("proximity_batch", "phi", r_a, q_a, r_b, q_b, phi, gradient, options, fast_rows,
+  run_batch("proximity_batch", "phi", r_a, q_a, r_b, q_b, phi, gradient, options, capsules,
             [&](const Pose& pose_a, const Pose& pose_b, Eigen::Index i) {
               const Proximity result = proximity(a, pose_a, b, pose_b, single);
               phi(i) = result.phi;
@@ -199,13 +198,9 @@ void signed_distance_batch(const Shape& a, const Eigen::Ref<const PositionArray>
                            const Eigen::Ref<const QuaternionArray>& q_b,
                            Eigen::Ref<Eigen::VectorXd> distance, Eigen::Ref<GradientArray> gradient,
                            const BatchOptions& options) {
-  const auto capsules = capsule_pair(a, b, detail::CapsuleMeasure::kSignedDistance);
-  const auto fast_rows = [&](Eigen::Index begin, Eigen::Index end, std::uint8_t* left) noexcept {
-    if (!capsules) return no_fast_rows(begin, end, left);
-    detail::capsule_rows(*capsules, r_a, q_a, r_b, q_b, begin, end, distance, gradient, left);
-  };
   run_batch("signed_distance_batch", "distance", r_a, q_a, r_b, q_b, distance, gradient, options,
-            fast_rows, [&](const Pose& pose_a, const Pose& pose_b, Eigen::Index i) {
+            capsule_pair(a, b, detail::CapsuleMeasure::kSignedDistance),
+            [&](const Pose& pose_a, const Pose& pose_b, Eigen::Index i) {
               const SignedDistance result = signed_distance(a, pose_a, b, pose_b);
               distance(i) = result.distance;
               gradient.row(i) = result.gradient.transpose();

@@ -25,10 +25,13 @@ struct Quaternion {
   V inverse_norm;  // 1 / |q| of the input
 };
 
-// q / |q| and 1 / |q| (one square root, one division per lane).
-HWY_INLINE Quaternion normalized(V w, V x, V y, V z) {
+HWY_INLINE V squared_norm(V w, V x, V y, V z) {
+  return hn::MulAdd(w, w, hn::MulAdd(x, x, hn::MulAdd(y, y, z * z)));
+}
+
+// q / |q| and 1 / |q| from |q|^2 (one square root, one division per lane).
+HWY_INLINE Quaternion normalized(V w, V x, V y, V z, V norm2) {
   const D d;
-  const V norm2 = hn::MulAdd(w, w, hn::MulAdd(x, x, hn::MulAdd(y, y, z * z)));
   const V inverse = hn::Set(d, 1.0) / hn::Sqrt(norm2);
   return {w * inverse, x * inverse, y * inverse, z * inverse, inverse};
 }
@@ -91,15 +94,14 @@ HWY_INLINE void chunk(const CapsulePair& pair, const double (*in)[kMaxLanes],
   for (const V& r : {ray, raz, rbx, rby, rbz}) {
     generic = hn::And(generic, hn::Le(hn::Abs(r), position_limit));
   }
-  for (const V& norm2 :
-       {hn::MulAdd(qaw, qaw, hn::MulAdd(qax, qax, hn::MulAdd(qay, qay, qaz * qaz))),
-        hn::MulAdd(qbw, qbw, hn::MulAdd(qbx, qbx, hn::MulAdd(qby, qby, qbz * qbz)))}) {
+  const V norm2_a = squared_norm(qaw, qax, qay, qaz), norm2_b = squared_norm(qbw, qbx, qby, qbz);
+  for (const V& norm2 : {norm2_a, norm2_b}) {
     generic = hn::And(
         generic, hn::And(hn::Ge(norm2, hn::Set(d, 0x1p-60)), hn::Le(norm2, hn::Set(d, 0x1p60))));
   }
 
-  const Quaternion qa = normalized(qaw, qax, qay, qaz);
-  const Quaternion qb = normalized(qbw, qbx, qby, qbz);
+  const Quaternion qa = normalized(qaw, qax, qay, qaz, norm2_a);
+  const Quaternion qb = normalized(qbw, qbx, qby, qbz, norm2_b);
   V ux, uy, uz, vx, vy, vz;
   axis(qa, ux, uy, uz);
   axis(qb, vx, vy, vz);
