@@ -1,7 +1,8 @@
 // The capsule pairs' vector kernel (src/capsule_rows.hpp), on every instruction set this machine
 // runs: the rows it answers agree with a brute-force reference in long double (phi, the signed
 // distance) and with the scalar path (values and gradients, to 1e-12 of the scene), its gradients
-// with central differences, and it leaves every degenerate row to the scalar path.
+// with central differences; swapping the capsules, moving the scene rigidly and scaling it by a
+// power of two act on them as they must; and it leaves every degenerate row to the scalar path.
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
@@ -11,6 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "capsule_rows.hpp"
@@ -146,6 +148,77 @@ TEST(CapsuleRows, AnsweredRowsMatchBruteForceAndTheScalarPath) {
         }
         // Random poses are almost all generic: the kernel answers them, not the scalar path.
         EXPECT_GE(answered, 1'400) << "scale " << scale;
+      }
+    }
+  });
+}
+
+// Properties of the kernel's rows, on every instruction set: swapping the capsules gives the same
+// value and the gradient with its halves exchanged, moving the whole scene rigidly leaves the value
+// unchanged, and scaling every length by a power of two scales the value and gradient exactly
+// (the kernel's arithmetic is then the same up to exponents).
+TEST(CapsuleRows, SwapRigidMotionAndPowerOfTwoScaling) {
+  on_every_target([] {
+    Rng rng(404);
+    const TestShape a = random_capsule(rng, 1.0), b = random_capsule(rng, 1.0);
+    const auto& capsule_a = std::get<Capsule>(a.shape);
+    const auto& capsule_b = std::get<Capsule>(b.shape);
+    for (const CapsuleMeasure measure : {CapsuleMeasure::kPhi, CapsuleMeasure::kSignedDistance}) {
+      const CapsulePair pair{capsule_a.length(), capsule_a.radius(), capsule_b.length(),
+                             capsule_b.radius(), measure};
+      const CapsulePair swapped{pair.length_b, pair.radius_b, pair.length_a, pair.radius_a,
+                                measure};
+      const int lengths = measure == CapsuleMeasure::kPhi ? 2 : 1;
+      const Rows rows = random_rows(rng, 300, 1.5);
+      const Answers answers = kernel(pair, rows);
+      const Answers swap = kernel(swapped, Rows{rows.r_b, rows.r_a, rows.q_b, rows.q_a});
+      // The whole scene turned by q_turn about the origin and moved by r_turn.
+      const Pose turn = random_pose(rng, 2.0);
+      const Eigen::Quaterniond q_turn(turn.q()(0), turn.q()(1), turn.q()(2), turn.q()(3));
+      Rows moved = rows;
+      for (Eigen::Index i = 0; i < rows.size(); ++i) {
+        for (auto [r, q] : {std::pair{&moved.r_a, &moved.q_a}, std::pair{&moved.r_b, &moved.q_b}}) {
+          r->row(i) =
+              (q_turn.normalized() * Eigen::Vector3d(r->row(i).transpose()) + turn.r()).transpose();
+          const Eigen::Quaterniond q_row((*q)(i, 0), (*q)(i, 1), (*q)(i, 2), (*q)(i, 3));
+          const Eigen::Quaterniond composed = q_turn.normalized() * q_row;
+          q->row(i) << composed.w(), composed.x(), composed.y(), composed.z();
+        }
+      }
+      const Answers motion = kernel(pair, moved);
+      constexpr int kExponent = 13;
+      Rows scaled = rows;
+      scaled.r_a *= std::ldexp(1.0, kExponent);
+      scaled.r_b *= std::ldexp(1.0, kExponent);
+      const CapsulePair big{
+          std::ldexp(pair.length_a, kExponent), std::ldexp(pair.radius_a, kExponent),
+          std::ldexp(pair.length_b, kExponent), std::ldexp(pair.radius_b, kExponent), measure};
+      const Answers large = kernel(big, scaled);
+      for (Eigen::Index i = 0; i < rows.size(); ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        ASSERT_EQ(swap.left[k], answers.left[k]) << "row " << i;
+        ASSERT_EQ(large.left[k], answers.left[k]) << "row " << i;
+        if (answers.left[k] != 0) continue;
+        const double size = scene_size(pair, rows, i);
+        const double unit = lengths == 2 ? size : 1.0;
+        EXPECT_NEAR(swap.value(i), answers.value(i), 1e-12 * size * unit) << "row " << i;
+        for (int j = 0; j < 14; ++j) {
+          const bool quaternion = (j >= 3 && j < 7) || j >= 10;
+          const double tolerance = 1e-12 * unit * (quaternion ? 2 * size : 1.0);  // |q| >= 0.5
+          EXPECT_NEAR(swap.gradient(i, (j + 7) % 14), answers.gradient(i, j), tolerance)
+              << "row " << i << ", entry " << j;
+        }
+        if (motion.left[k] == 0) {
+          EXPECT_NEAR(motion.value(i), answers.value(i), 1e-12 * size * unit) << "row " << i;
+        }
+        // Exact: every length carries 2^13, the quaternions are unchanged.
+        EXPECT_EQ(large.value(i), std::ldexp(answers.value(i), lengths * kExponent)) << "row " << i;
+        for (int j = 0; j < 14; ++j) {
+          const bool quaternion = (j >= 3 && j < 7) || j >= 10;
+          const int power = (lengths - 1) + (quaternion ? 1 : 0);
+          EXPECT_EQ(large.gradient(i, j), std::ldexp(answers.gradient(i, j), power * kExponent))
+              << "row " << i << ", entry " << j;
+        }
       }
     }
   });
