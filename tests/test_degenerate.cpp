@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "diffpills/diffpills.hpp"
 #include "support/random_shapes.hpp"
@@ -304,6 +305,29 @@ TEST(Degenerate, ExtremeScalesWithMixedSizes) {
   EXPECT_NEAR(std::sqrt(r.phi + std::pow(1.0 + 1e-4, 2)), lowest_z, 1e-9);
   const ProximityJacobian s = query(huge, Pose(), tiny, tiny_pose);
   EXPECT_NEAR(s.phi, r.phi, 1e-9);
+}
+
+// A scene of subnormal numbers: the frame stops at 2^-1000 (pair_frame.hpp), so the scene is
+// 2^-52 in it rather than 1. The normal rules used to take its size as 1: any feature normal then
+// "agreed" with the closest points' direction, and two capsules of length 5e-324, 1e-317 apart
+// along x, got the normal z (fuzz_proximity). The normal follows the points again, for proximity
+// and the signed distance, and the witness points differ by distance * normal.
+TEST(Degenerate, SubnormalSceneNormalFollowsThePoints) {
+  const double m = std::numeric_limits<double>::denorm_min();
+  const Capsule a(m, m), b(m, m);
+  const Pose pose_a({m, m, m}, Eigen::Vector4d(std::sqrt(0.5), 0, 0, std::sqrt(0.5)));
+  const Pose pose_b({-1.0361307573072619e-317, m, m}, Eigen::Vector4d(-0.5, 0.5, -0.5, 0.5));
+  const Eigen::Vector3d along(-1, 0, 0);
+  for (const bool swapped : {false, true}) {
+    const double sign = swapped ? -1.0 : 1.0;
+    const Proximity p = swapped ? proximity(b, pose_b, a, pose_a) : proximity(a, pose_a, b, pose_b);
+    EXPECT_LT((p.normal - sign * along).norm(), 1e-12) << swapped;
+    const SignedDistance s =
+        swapped ? signed_distance(b, pose_b, a, pose_a) : signed_distance(a, pose_a, b, pose_b);
+    EXPECT_FALSE(s.penetrating);
+    EXPECT_LT((s.normal - sign * along).norm(), 1e-12) << swapped;
+    EXPECT_LE((s.points[1] - s.points[0] - s.distance * s.normal).lpNorm<Eigen::Infinity>(), 8 * m);
+  }
 }
 
 // Slivers: spikes whose rows, grown by the tolerance, would meet far beyond the apex (at

@@ -9,15 +9,17 @@ namespace diffpills::detail {
 
 NormalSource points_normal_source(const PosedCore& a, const ClosestFeature& side_a,
                                   const PosedCore& b, const ClosestFeature& side_b,
-                                  const Eigen::Vector3d& d) {
+                                  const Eigen::Vector3d& d, double unit) {
   NormalSource source;
   const double length = d.norm();
   // A feature's normal must agree with d / |d| to d's own uncertainty (a few ulps of the scene,
-  // in [1, 2) here, over |d|; 250 times that), or the features do not hold the points as their
+  // `unit` here, over |d|; 250 times that), or the features do not hold the points as their
   // labels say: a segment of zero length in the frame (a polygon 1e-300 of a scene of 1e70, found
-  // by fuzz_proximity) or a point labelled inside an edge by rounding at its end.
+  // by fuzz_proximity) or a point labelled inside an edge by rounding at its end. (With the
+  // scene's size taken as 1 in a subnormal scene's frame, where it is 2^-52, any normal agreed:
+  // fuzz_proximity found two capsules 1e-317 apart along x given the normal z.)
   const auto agrees = [&](const Eigen::Vector3d& normal) {
-    return (normal - d / length).norm() <= 1e-12 * (1.0 + 1.0 / length);
+    return (normal - d / length).norm() <= 1e-12 * (1.0 + unit / length);
   };
   for (int core = 0; core < 2; ++core) {
     const ClosestFeature& side = core == 0 ? side_a : side_b;
@@ -37,7 +39,7 @@ NormalSource points_normal_source(const PosedCore& a, const ClosestFeature& side
     const Eigen::Vector3d c = stable_cross(e, f);
     const double sine = c.norm();
     const double sign = c.dot(d) >= 0.0 ? 1.0 : -1.0;
-    if (sine >= length && agrees(sign * c / sine)) {
+    if (sine * unit >= length && agrees(sign * c / sine)) {
       source.kind = NormalSource::Kind::kEdges;
       source.sign = sign;
       source.edge_directions = {side_a.free_directions.col(0), side_b.free_directions.col(0)};

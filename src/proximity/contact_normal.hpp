@@ -11,8 +11,8 @@
 //     so the normal is +-Q e_z of that polygon, exact to a few ulps;
 //   - two points inside two edges (both sides free in one direction), not parallel: d is normal
 //     to both, so the normal is +-(e x f) / |e x f|, known to ~eps / |sin(e, f)|; taken when that
-//     is the smaller error, |sin| >= |d| (in the frame's units, where the scene's size is in
-//     [1, 2)).
+//     is the smaller error, |sin| >= |d| / unit (unit the scene's size in the frame, rounded down
+//     to a power of two: 1 but for subnormal scenes, pair_frame.hpp).
 // Otherwise (a vertex or a segment's end on either side, or edges too close to parallel) d / |d|
 // is what there is: the problem itself is then that ill-conditioned. The sign follows d, and a
 // feature's normal is taken only if it agrees with d / |d| to d's own uncertainty: one that does
@@ -41,10 +41,10 @@ struct NormalSource {
 };
 
 // The source of the normal of points x1 = a's side, x2 = b's side, d = x2 - x1 (nonzero), by the
-// rules above.
+// rules above; `unit` is the frame's PairFrame::unit.
 NormalSource points_normal_source(const PosedCore& a, const ClosestFeature& side_a,
                                   const PosedCore& b, const ClosestFeature& side_b,
-                                  const Eigen::Vector3d& d);
+                                  const Eigen::Vector3d& d, double unit);
 
 // The normal of a source (kClosestPoints: d / |d|; not for kFixed).
 Eigen::Vector3d source_normal(const NormalSource& source, const PosedCore& a, const PosedCore& b,

@@ -19,14 +19,19 @@ PairFrame make_pair_frame(double size_a, double radius_a, double size_b, double 
   const double size = std::max({size_a, size_b, radius_a, radius_b, distance});
   PairFrame frame;
   if (size > 0.0) {
-    const int exponent = std::max(std::ilogb(size), -1000);
+    const int size_exponent = std::ilogb(size);
+    const int exponent = std::max(size_exponent, -1000);
     frame.scale = std::ldexp(1.0, exponent);
     frame.inverse_scale = std::ldexp(1.0, -exponent);
+    frame.unit = std::ldexp(1.0, size_exponent - exponent);
   }
-  frame.tolerance = 1e-12 * size * frame.inverse_scale;
-  frame.tie_tolerance =
-      (2e-12 * std::max(size_a, size_b) + 64 * std::numeric_limits<double>::epsilon() * size) *
-      frame.inverse_scale;
+  // The sizes are brought into the frame before the factors are applied: the other order
+  // underflows for a subnormal scene (1e-12 of 1e-317), where the frame's sizes are normal. Both
+  // orders give the same bits otherwise (a power of two commutes with rounding).
+  const double frame_size = size * frame.inverse_scale;
+  frame.tolerance = 1e-12 * frame_size;
+  frame.tie_tolerance = 2e-12 * (std::max(size_a, size_b) * frame.inverse_scale) +
+                        64 * std::numeric_limits<double>::epsilon() * frame_size;
   return frame;
 }
 

@@ -17,6 +17,11 @@ namespace diffpills::detail {
 struct PairFrame {
   double scale = 1.0;          // a length in the frame times scale is a length of the inputs
   double inverse_scale = 1.0;  // 1 / scale, exact (also a power of two)
+  // The scene's size in the frame, rounded down to a power of two: 1, except for a scene below
+  // 2^-1000 (of subnormal numbers), whose frame stops at 2^-1000 (1 / scale must stay finite) so
+  // that its size in the frame is 2^-74 .. 2^-1. Rules that compare with "the scene's size in the
+  // frame" (contact_normal.hpp) use this rather than assume 1.
+  double unit = 1.0;
   // Two cores closer than this intersect, and a point closer than this to a polygon's boundary
   // is on it: the relative intersection tolerance, 1e-12 of the scene's size, in the frame's
   // units.

@@ -57,8 +57,8 @@ Proximity make_proximity(const PairFrame& frame, const Pose& pose_a, const Posed
   const NormalRule rule = normal_rule(frame, a, b, p1, p2);
   switch (rule) {
     case NormalRule::kClosestPoints:  // from the features where they fix it (contact_normal.hpp)
-      result.normal =
-          source_normal(points_normal_source(a, side_a, b, side_b, -difference), a, b, -difference);
+      result.normal = source_normal(
+          points_normal_source(a, side_a, b, side_b, -difference, frame.unit), a, b, -difference);
       break;
     case NormalRule::kOrigins:
       result.normal = (b.r - a.r).normalized();
@@ -99,8 +99,8 @@ PointMotion add_point_jacobians(const PairFrame& frame, const PosedCore& a,
   Matrix3x14 dnormal = Matrix3x14::Zero();
   switch (normal_rule(frame, a, b, p1, p2)) {
     case NormalRule::kClosestPoints:
-      dnormal = source_normal_motion(points_normal_source(a, side_a, b, side_b, p2 - p1), a, b,
-                                     p2 - p1, motion);
+      dnormal = source_normal_motion(
+          points_normal_source(a, side_a, b, side_b, p2 - p1, frame.unit), a, b, p2 - p1, motion);
       break;
     case NormalRule::kOrigins: {
       Matrix3x14 d_origins = Matrix3x14::Zero();  // d(r2 - r1)

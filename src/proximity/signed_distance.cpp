@@ -94,8 +94,8 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   const double apart = (x2 - x1).norm();
   if (apart > frame.tolerance) {
     solution.gap = apart;
-    solution.source =
-        detail::points_normal_source(pa, solution.sides[0], pb, solution.sides[1], x2 - x1);
+    solution.source = detail::points_normal_source(pa, solution.sides[0], pb, solution.sides[1],
+                                                   x2 - x1, frame.unit);
     solution.normal = detail::source_normal(solution.source, pa, pb, x2 - x1);
     return solution;
   }
