@@ -1,0 +1,260 @@
+// proximity() of two capsules in the generic case takes a fused pass (src/proximity/
+// capsule_proximity.hpp) instead of the general pipeline. Checked here against references that
+// share none of its code: a long-double brute force (phi, the closest points, the normal), the
+// general pipeline as proximity_jacobian runs it (every field), central differences (the
+// gradient); and by properties: a scene scaled by 2^k scales every result exactly, swapping the
+// capsules swaps the results, a rigid motion leaves phi. Rows on both sides of each boundary of
+// the generic case (nearly parallel axes, close cores, short capsules, tiny scenes) agree with the
+// brute force too, so nothing jumps where the path changes.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "diffpills/diffpills.hpp"
+#include "proximity/capsule_proximity.hpp"
+#include "support/random_shapes.hpp"
+#include "support/reference.hpp"
+
+namespace diffpills::testing {
+namespace {
+
+struct Pair {
+  Capsule a, b;
+  Pose pose_a, pose_b;
+};
+
+TestShape as_test_shape(const Capsule& capsule) {
+  const double h = 0.5 * capsule.length();
+  return {capsule, {{-h, 0, 0}, {h, 0, 0}}, capsule.length()};
+}
+
+// The scene's size: the largest of the lengths, the radii's sum and the middles' distance.
+double scene_size(const Pair& p) {
+  return std::max({p.a.length(), p.b.length(), p.a.radius() + p.b.radius(),
+                   (p.pose_a.r() - p.pose_b.r()).norm()});
+}
+
+bool generic(const Pair& p) {
+  Proximity unused;
+  return detail::generic_capsule_proximity(p.a, p.pose_a, p.b, p.pose_b, unused);
+}
+
+Proximity fused(const Pair& p) { return proximity(p.a, p.pose_a, p.b, p.pose_b); }
+
+// Every field of the fused answer against the long-double brute force and against the general
+// pipeline (proximity_jacobian's Proximity part), relative to the scene's size S.
+void expect_matches_references(const Pair& p, double tolerance) {
+  const Proximity fast = fused(p);
+  const Proximity general = proximity_jacobian(p.a, p.pose_a, p.b, p.pose_b);
+  const ClosestPair brute = brute_force_closest(to_world(as_test_shape(p.a), p.pose_a),
+                                                to_world(as_test_shape(p.b), p.pose_b));
+  const double S = scene_size(p);
+  const long double radii = static_cast<long double>(p.a.radius()) + p.b.radius();
+  const double phi = static_cast<double>(brute.distance * brute.distance - radii * radii);
+  ASSERT_NEAR(fast.phi, phi, tolerance * S * S);
+  ASSERT_NEAR(fast.phi, general.phi, tolerance * S * S);
+  ASSERT_FALSE(fast.cores_intersect);
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_NEAR(fast.core_points[0](k), static_cast<double>(brute.p1(k)), tolerance * S);
+    ASSERT_NEAR(fast.core_points[1](k), static_cast<double>(brute.p2(k)), tolerance * S);
+    for (int i = 0; i < 2; ++i) {
+      ASSERT_NEAR(fast.core_points[i](k), general.core_points[i](k), tolerance * S);
+      ASSERT_NEAR(fast.points[i](k), general.points[i](k), tolerance * S);
+    }
+    ASSERT_NEAR(fast.normal(k), general.normal(k), tolerance);
+    const Vec3L direction = (brute.p2 - brute.p1) / brute.distance;
+    ASSERT_NEAR(fast.normal(k), static_cast<double>(direction(k)), tolerance);
+  }
+  for (int block : {0, 7}) {
+    const double q_norm = (block == 0 ? p.pose_a : p.pose_b).q().norm();
+    for (int j = 0; j < 3; ++j) {
+      ASSERT_NEAR(fast.gradient(block + j), general.gradient(block + j), tolerance * S);
+    }
+    for (int j = 3; j < 7; ++j) {
+      ASSERT_NEAR(fast.gradient(block + j), general.gradient(block + j),
+                  tolerance * S * S / q_norm);
+    }
+  }
+}
+
+Pair random_pair(Rng& rng, double scale) {
+  const TestShape a = random_capsule(rng, scale), b = random_capsule(rng, scale);
+  return {std::get<Capsule>(a.shape), std::get<Capsule>(b.shape), random_pose(rng, 1.5 * scale),
+          random_pose(rng, 1.5 * scale)};
+}
+
+TEST(CapsuleProximity, RandomPairsMatchBruteForceAndTheGeneralPipeline) {
+  Rng rng(1301);
+  for (const double scale : {0x1p-30, 1.0, 0x1p30}) {
+    int answered = 0;
+    const int n = 3'000;
+    for (int i = 0; i < n; ++i) {
+      const Pair p = random_pair(rng, scale);
+      if (!generic(p)) continue;
+      ++answered;
+      SCOPED_TRACE(i);
+      expect_matches_references(p, 1e-13);
+    }
+    // The path is what random poses take: the test exercises it, not the fallback.
+    EXPECT_GT(answered, 0.85 * n) << "scale " << scale;
+  }
+}
+
+// Central differences of phi in every position coordinate and every raw quaternion component
+// (the gradient refers to q as given, normalization included).
+TEST(CapsuleProximity, GradientMatchesCentralDifferences) {
+  Rng rng(1302);
+  int checked = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Pair p = random_pair(rng, 1.0);
+    if (!generic(p)) continue;
+    ++checked;
+    const Eigen::Matrix<double, 14, 1> gradient = fused(p).gradient;
+    for (int j = 0; j < 14; ++j) {
+      const double step = 1e-6;
+      const auto phi_at = [&](double delta) {
+        Eigen::Vector3d r_a = p.pose_a.r(), r_b = p.pose_b.r();
+        Eigen::Vector4d q_a = p.pose_a.q(), q_b = p.pose_b.q();
+        if (j < 3)
+          r_a(j) += delta;
+        else if (j < 7)
+          q_a(j - 3) += delta;
+        else if (j < 10)
+          r_b(j - 7) += delta;
+        else
+          q_b(j - 10) += delta;
+        return proximity(p.a, Pose(r_a, q_a), p.b, Pose(r_b, q_b)).phi;
+      };
+      const double difference = (phi_at(step) - phi_at(-step)) / (2 * step);
+      ASSERT_NEAR(gradient(j), difference, 1e-6 * (1 + std::abs(difference)))
+          << "pair " << i << ", entry " << j;
+    }
+  }
+  EXPECT_GT(checked, 250);
+}
+
+Pose scaled(const Pose& pose, int k) { return Pose(std::ldexp(1.0, k) * pose.r(), pose.q()); }
+
+// Lengths divided by a power of two of the scene (capsule_proximity.hpp): a scene scaled by 2^k
+// gives the same bits scaled, phi by 2^2k, points and the position gradient by 2^k, the
+// quaternion gradient by 2^2k, the normal not at all; and the same rows take the path.
+TEST(CapsuleProximity, ScalingByAPowerOfTwoIsExact) {
+  Rng rng(1303);
+  for (int i = 0; i < 200; ++i) {
+    const Pair p = random_pair(rng, 1.0);
+    const Proximity base = fused(p);
+    for (const int k : {-960, -300, -13, 13, 300, 325}) {
+      const double f = std::ldexp(1.0, k);
+      const Pair big{Capsule(f * p.a.length(), f * p.a.radius()),
+                     Capsule(f * p.b.length(), f * p.b.radius()), scaled(p.pose_a, k),
+                     scaled(p.pose_b, k)};
+      ASSERT_EQ(generic(big), generic(p)) << "pair " << i << ", k = " << k;
+      const Proximity result = fused(big);
+      ASSERT_EQ(result.phi, std::ldexp(base.phi, 2 * k)) << "pair " << i << ", k = " << k;
+      ASSERT_EQ(result.normal, base.normal);
+      for (int c = 0; c < 2; ++c) {
+        ASSERT_EQ(result.core_points[c], f * base.core_points[c]);
+        ASSERT_EQ(result.points[c], f * base.points[c]);
+      }
+      for (const int block : {0, 7}) {
+        ASSERT_EQ(result.gradient.segment<3>(block), f * base.gradient.segment<3>(block));
+        ASSERT_EQ(result.gradient.segment<4>(block + 3),
+                  std::ldexp(1.0, 2 * k) * base.gradient.segment<4>(block + 3));
+      }
+    }
+  }
+}
+
+TEST(CapsuleProximity, SwappingTheCapsulesSwapsTheResults) {
+  Rng rng(1304);
+  for (int i = 0; i < 1'000; ++i) {
+    const Pair p = random_pair(rng, 1.0);
+    const Proximity ab = fused(p);
+    const Proximity ba = proximity(p.b, p.pose_b, p.a, p.pose_a);
+    const double S = scene_size(p);
+    ASSERT_NEAR(ab.phi, ba.phi, 1e-14 * S * S) << "pair " << i;
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_NEAR(ab.normal(k), -ba.normal(k), 1e-13);
+      ASSERT_NEAR(ab.core_points[0](k), ba.core_points[1](k), 1e-13 * S);
+      ASSERT_NEAR(ab.points[1](k), ba.points[0](k), 1e-13 * S);
+    }
+    for (int j = 0; j < 7; ++j) {
+      ASSERT_NEAR(ab.gradient(j), ba.gradient(7 + j), 1e-13 * S * S * (1 + S));
+      ASSERT_NEAR(ab.gradient(7 + j), ba.gradient(j), 1e-13 * S * S * (1 + S));
+    }
+  }
+}
+
+TEST(CapsuleProximity, RigidMotionLeavesPhi) {
+  Rng rng(1305);
+  for (int i = 0; i < 500; ++i) {
+    const Pair p = random_pair(rng, 1.0);
+    const Eigen::Quaterniond turn = Eigen::Quaterniond::UnitRandom();
+    const Eigen::Vector3d shift = Eigen::Vector3d::Random() * 4.0;
+    const auto moved = [&](const Pose& pose) {
+      const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
+      const Eigen::Quaterniond turned = turn * q;
+      return Pose(turn * pose.r() + shift,
+                  Eigen::Vector4d(turned.w(), turned.x(), turned.y(), turned.z()));
+    };
+    const Proximity before = fused(p);
+    const Proximity after = proximity(p.a, moved(p.pose_a), p.b, moved(p.pose_b));
+    const double S = scene_size(p) + shift.norm();
+    ASSERT_NEAR(after.phi, before.phi, 1e-13 * S * S) << "pair " << i;
+    ASSERT_LT((after.normal - turn * before.normal).norm(), 1e-12) << "pair " << i;
+  }
+}
+
+// Both sides of each boundary of the generic case: the fused path on one side, the general
+// pipeline on the other, both against the brute force.
+TEST(CapsuleProximity, BoundariesOfTheGenericCase) {
+  const Capsule a(1.0, 0.1), b(0.8, 0.2);
+  const Eigen::Vector4d identity(1, 0, 0, 0);
+  const auto about_z = [](double angle) {
+    return Eigen::Vector4d(std::cos(angle / 2), 0, 0, std::sin(angle / 2));
+  };
+  // Axes apart by an angle whose sine squared is 1e-2 (the threshold), times 1 -+ 1e-6 and
+  // further each way; the cores 0.3 apart across z.
+  const double threshold = std::asin(0.1);
+  for (const double factor : {0.5, 0.99, 1 - 1e-6, 1 + 1e-6, 1.01, 2.0}) {
+    const Pair p{a, b, Pose({0.1, 0.05, 0}, identity),
+                 Pose({-0.05, 0.02, 0.3}, about_z(threshold * factor))};
+    EXPECT_EQ(generic(p), factor > 1) << factor;
+    SCOPED_TRACE(factor);
+    expect_matches_references(p, 1e-13);
+  }
+  // Crossing cores a gap g apart: the path needs g > 1e-2 of the frame's power of two (1 here:
+  // the scene's size is 1).
+  for (const double gap : {0.5e-2, 0.999e-2, 1.001e-2, 2e-2, 0.3}) {
+    const Pair p{a, b, Pose({0, 0, 0}, identity), Pose({0, 0, gap}, about_z(M_PI / 2))};
+    EXPECT_EQ(generic(p), gap > 1e-2) << gap;
+    SCOPED_TRACE(gap);
+    expect_matches_references(p, 1e-13);
+  }
+  // A zero-length capsule (a sphere) and one below 2^-500 of the scene are the general
+  // pipeline's; one just above takes the path.
+  const Pose crossed({0, 0, 0.4}, about_z(M_PI / 3));
+  EXPECT_FALSE(generic({Capsule(0.0, 0.1), b, Pose(), crossed}));
+  EXPECT_FALSE(generic({Capsule(0x1p-502, 0.1), b, Pose(), crossed}));
+  EXPECT_TRUE(generic({Capsule(0x1p-499, 0.1), b, Pose(), crossed}));
+  // Scenes below 2^-1000 are the general pipeline's (1 / scale would not be a normal number);
+  // their points and normal scale as the path's (phi, of order 2^-2000, underflows).
+  const Pair unit{a, b, Pose({0.1, 0.05, 0}, identity), Pose({-0.05, 0.02, 0.3}, about_z(1.0))};
+  ASSERT_TRUE(generic(unit));
+  const int k = -1001;
+  const double f = std::ldexp(1.0, k);
+  const Pair tiny{Capsule(f * a.length(), f * a.radius()), Capsule(f * b.length(), f * b.radius()),
+                  scaled(unit.pose_a, k), scaled(unit.pose_b, k)};
+  EXPECT_FALSE(generic(tiny));
+  const Proximity result = fused(tiny), base = fused(unit);
+  EXPECT_LT((result.normal - base.normal).norm(), 1e-13);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_LT((std::ldexp(1.0, -k) * result.core_points[c] - base.core_points[c]).norm(), 1e-13);
+  }
+}
+
+}  // namespace
+}  // namespace diffpills::testing
