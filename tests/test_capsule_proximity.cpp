@@ -1,11 +1,12 @@
-// proximity() of two capsules in the generic case takes a fused pass (src/proximity/
-// capsule_proximity.hpp) instead of the general pipeline. Checked here against references that
-// share none of its code: a long-double brute force (phi, the closest points, the normal), the
-// general pipeline as proximity_jacobian runs it (every field), central differences (the
-// gradient); and by properties: a scene scaled by 2^k scales every result exactly, swapping the
-// capsules swaps the results, a rigid motion leaves phi. Rows on both sides of each boundary of
-// the generic case (nearly parallel axes, close cores, short capsules, tiny scenes) agree with the
-// brute force too, so nothing jumps where the path changes.
+// proximity() and proximity_jacobian() of two capsules in the generic case take a fused pass
+// (src/proximity/capsule_proximity.hpp) instead of the general pipeline. Checked here against
+// references that share none of its code: a long-double brute force (phi, the closest points, the
+// normal), the general pipeline as proximity_hessian runs it (every field, the Jacobians too),
+// central differences (the gradient, the points' Jacobians); and by properties: a scene scaled by
+// 2^k scales every result exactly, swapping the capsules swaps the results, a rigid motion leaves
+// phi. Rows on both sides of each boundary of the generic case (nearly parallel axes, close cores,
+// short capsules, tiny scenes) agree with the brute force too, so nothing jumps where the path
+// changes.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -45,10 +46,10 @@ bool generic(const Pair& p) {
 Proximity fused(const Pair& p) { return proximity(p.a, p.pose_a, p.b, p.pose_b); }
 
 // Every field of the fused answer against the long-double brute force and against the general
-// pipeline (proximity_jacobian's Proximity part), relative to the scene's size S.
+// pipeline (proximity_hessian, which always takes it), relative to the scene's size S.
 void expect_matches_references(const Pair& p, double tolerance) {
   const Proximity fast = fused(p);
-  const Proximity general = proximity_jacobian(p.a, p.pose_a, p.b, p.pose_b);
+  const ProximityHessian general = proximity_hessian(p.a, p.pose_a, p.b, p.pose_b);
   const ClosestPair brute = brute_force_closest(to_world(as_test_shape(p.a), p.pose_a),
                                                 to_world(as_test_shape(p.b), p.pose_b));
   const double S = scene_size(p);
@@ -76,6 +77,30 @@ void expect_matches_references(const Pair& p, double tolerance) {
     for (int j = 3; j < 7; ++j) {
       ASSERT_NEAR(fast.gradient(block + j), general.gradient(block + j),
                   tolerance * S * S / q_norm);
+    }
+  }
+  // The Jacobians: the Proximity part is the same pass's, bit for bit; the points' Jacobians
+  // against the general pipeline's, position columns unitless, quaternion columns in length per
+  // unit of q; the surface points' carry the normal's motion, 1 / |p1 - p2| (>= 1e-2 S / 2 here).
+  const ProximityJacobian jacobian = proximity_jacobian(p.a, p.pose_a, p.b, p.pose_b);
+  ASSERT_EQ(jacobian.phi, fast.phi);
+  ASSERT_EQ(jacobian.gradient, fast.gradient);
+  ASSERT_EQ(jacobian.normal, fast.normal);
+  ASSERT_EQ(jacobian.points[0], fast.points[0]);
+  ASSERT_EQ(jacobian.core_points[1], fast.core_points[1]);
+  const double gap = static_cast<double>(brute.distance);
+  const double radius = std::max(p.a.radius(), p.b.radius());
+  for (int row = 0; row < 6; ++row) {
+    for (int column = 0; column < 14; ++column) {
+      const bool rotation = (column >= 3 && column < 7) || column >= 10;
+      const double q_norm = (column < 7 ? p.pose_a : p.pose_b).q().norm();
+      const double unit = rotation ? S / q_norm : 1.0;
+      ASSERT_NEAR(jacobian.core_points_jacobian(row, column),
+                  general.core_points_jacobian(row, column), tolerance * unit)
+          << row << ", " << column;
+      ASSERT_NEAR(jacobian.points_jacobian(row, column), general.points_jacobian(row, column),
+                  tolerance * unit * (1 + radius / gap))
+          << row << ", " << column;
     }
   }
 }
@@ -134,6 +159,56 @@ TEST(CapsuleProximity, GradientMatchesCentralDifferences) {
     }
   }
   EXPECT_GT(checked, 250);
+}
+
+// Central differences of the surface and core points (proximity(), the fused pass's own points)
+// against proximity_jacobian's Jacobians, on pairs of each kind of closest points: both inside
+// their segments, one at an end, both at ends (counted from the brute force's points).
+TEST(CapsuleProximity, JacobiansMatchCentralDifferences) {
+  Rng rng(1306);
+  int kinds[3] = {0, 0, 0};  // closest points at 0, 1 or 2 segment ends
+  for (int i = 0; i < 400; ++i) {
+    const Pair p = random_pair(rng, 1.0);
+    if (!generic(p)) continue;
+    const ProximityJacobian jacobian = proximity_jacobian(p.a, p.pose_a, p.b, p.pose_b);
+    const ClosestPair brute = brute_force_closest(to_world(as_test_shape(p.a), p.pose_a),
+                                                  to_world(as_test_shape(p.b), p.pose_b));
+    const WorldCore ends_a = to_world(as_test_shape(p.a), p.pose_a);
+    const WorldCore ends_b = to_world(as_test_shape(p.b), p.pose_b);
+    const auto at_an_end = [](const Vec3L& point, const WorldCore& core) {
+      return (point - core.vertices[0]).norm() < 1e-9 || (point - core.vertices[1]).norm() < 1e-9;
+    };
+    ++kinds[static_cast<int>(at_an_end(brute.p1, ends_a)) +
+            static_cast<int>(at_an_end(brute.p2, ends_b))];
+    for (int j = 0; j < 14; ++j) {
+      const double step = 1e-6;
+      const auto at = [&](double delta) {
+        Eigen::Vector3d r_a = p.pose_a.r(), r_b = p.pose_b.r();
+        Eigen::Vector4d q_a = p.pose_a.q(), q_b = p.pose_b.q();
+        if (j < 3)
+          r_a(j) += delta;
+        else if (j < 7)
+          q_a(j - 3) += delta;
+        else if (j < 10)
+          r_b(j - 7) += delta;
+        else
+          q_b(j - 10) += delta;
+        return proximity(p.a, Pose(r_a, q_a), p.b, Pose(r_b, q_b));
+      };
+      const Proximity plus = at(step), minus = at(-step);
+      for (int c = 0; c < 2; ++c) {
+        const Eigen::Vector3d core = (plus.core_points[c] - minus.core_points[c]) / (2 * step);
+        const Eigen::Vector3d surface = (plus.points[c] - minus.points[c]) / (2 * step);
+        ASSERT_LT((jacobian.core_points_jacobian.block<3, 1>(3 * c, j) - core).norm(),
+                  1e-6 * (1 + core.norm()))
+            << "pair " << i << ", point " << c << ", entry " << j;
+        ASSERT_LT((jacobian.points_jacobian.block<3, 1>(3 * c, j) - surface).norm(),
+                  1e-6 * (1 + surface.norm()))
+            << "pair " << i << ", point " << c << ", entry " << j;
+      }
+    }
+  }
+  for (const int count : kinds) EXPECT_GT(count, 20);
 }
 
 Pose scaled(const Pose& pose, int k) { return Pose(std::ldexp(1.0, k) * pose.r(), pose.q()); }
@@ -254,6 +329,38 @@ TEST(CapsuleProximity, BoundariesOfTheGenericCase) {
   for (int c = 0; c < 2; ++c) {
     EXPECT_LT((std::ldexp(1.0, -k) * result.core_points[c] - base.core_points[c]).norm(), 1e-13);
   }
+}
+
+// Two points inside their segments: the normal is -+(u x v) / |u x v|, as the general pipeline
+// takes it. D / |D| carries s's rounding, ~eps |w| / (sin^2 |D|): a hostile review's pair (both
+// axes in the xy plane, the normal exactly z) got (1.7e-13, -1.7e-14, 1) from it.
+TEST(CapsuleProximity, NormalOfTwoInnerPointsIsExact) {
+  const Pair p{Capsule(1.999, 0), Capsule(1.999, 0), Pose(),
+               Pose({-1.9136399208967076, 0.10399592593041433, 0.010362708799863365},
+                    Eigen::Vector4d(0.052887107911724768, 0, 0, 0.99860049760488978))};
+  ASSERT_TRUE(generic(p));
+  const Proximity ab = fused(p), ba = proximity(p.b, p.pose_b, p.a, p.pose_a);
+  EXPECT_LT((ab.normal - Eigen::Vector3d::UnitZ()).norm(), 1e-15);
+  EXPECT_LT((ab.normal + ba.normal).norm(), 1e-15);
+  EXPECT_EQ(proximity_jacobian(p.a, p.pose_a, p.b, p.pose_b).normal, ab.normal);
+}
+
+// A scene of 2^-538 with |q| = 2e-40: the quaternion gradient, ~1e-284, is a normal number, but
+// scale^2 = 2^-1076 is not; both paths multiply by scale twice (a hostile review found it
+// flushed to zero).
+TEST(CapsuleProximity, QuaternionGradientOfATinySceneDoesNotUnderflow) {
+  const double u = std::ldexp(1.0, -538);
+  const Pair p{Capsule(u, 0), Capsule(u, 0), Pose({0, 0, 0}, Eigen::Vector4d(2e-40, 0, 0, 0)),
+               Pose({1.2 * u, 1.2 * u, 1.2 * u},
+                    2e-40 * Eigen::Vector4d(std::sqrt(0.5), 0, 0, std::sqrt(0.5)))};
+  ASSERT_TRUE(generic(p));
+  const Proximity fast = fused(p);
+  const ProximityHessian general = proximity_hessian(p.a, p.pose_a, p.b, p.pose_b);
+  for (int j = 3; j < 7; ++j) {
+    EXPECT_NEAR(fast.gradient(j), general.gradient(j), 1e-12 * std::abs(general.gradient(j)));
+  }
+  EXPECT_GT(std::abs(fast.gradient(5)), 1e-285);  // dphi/dq_a's y part, 1.48e-284
+  EXPECT_GT(std::abs(general.gradient(5)), 1e-285);
 }
 
 }  // namespace

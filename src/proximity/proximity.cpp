@@ -90,7 +90,8 @@ Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& p
 }  // namespace
 
 // Two capsules in the generic case take one fused pass, half the general pipeline's cost
-// (capsule_proximity.hpp). One named result, so that it is built in place.
+// (capsule_proximity.hpp), and so do their Jacobians. One named result, so that it is built in
+// place.
 Proximity proximity(const Capsule& a, const Pose& pose_a, const Capsule& b, const Pose& pose_b,
                     const ProximityOptions& options) {
   Proximity result;
@@ -123,7 +124,12 @@ Proximity proximity(const Shape& a, const Pose& pose_a, const Shape& b, const Po
 
 ProximityJacobian proximity_jacobian(const Capsule& a, const Pose& pose_a, const Capsule& b,
                                      const Pose& pose_b, const ProximityOptions& options) {
-  return query<ProximityJacobian>(a, pose_a, b, pose_b, options);
+  ProximityJacobian result;
+  if (options.method != Method::kDefault ||
+      !detail::generic_capsule_proximity_jacobian(a, pose_a, b, pose_b, result)) {
+    result = query<ProximityJacobian>(a, pose_a, b, pose_b, options);
+  }
+  return result;
 }
 ProximityJacobian proximity_jacobian(const Capsule& a, const Pose& pose_a, const PaddedPolygon& b,
                                      const Pose& pose_b, const ProximityOptions& options) {
@@ -142,7 +148,7 @@ ProximityJacobian proximity_jacobian(const Shape& a, const Pose& pose_a, const S
                                      const Pose& pose_b, const ProximityOptions& options) {
   return std::visit(
       [&](const auto& shape_a, const auto& shape_b) {
-        return query<ProximityJacobian>(shape_a, pose_a, shape_b, pose_b, options);
+        return proximity_jacobian(shape_a, pose_a, shape_b, pose_b, options);
       },
       a, b);
 }
