@@ -45,6 +45,15 @@ bool generic(const Pair& p) {
 
 Proximity fused(const Pair& p) { return proximity(p.a, p.pose_a, p.b, p.pose_b); }
 
+// The pair with coordinate j of x = [r_a q_a r_b q_b] (q as given) moved by delta.
+Pair nudged(const Pair& p, int j, double delta) {
+  Eigen::Matrix<double, 14, 1> x;
+  x << p.pose_a.r(), p.pose_a.q(), p.pose_b.r(), p.pose_b.q();
+  x(j) += delta;
+  return {p.a, p.b, Pose(x.segment<3>(0), x.segment<4>(3)),
+          Pose(x.segment<3>(7), x.segment<4>(10))};
+}
+
 // Every field of the fused answer against the long-double brute force and against the general
 // pipeline (proximity_hessian, which always takes it), relative to the scene's size S.
 void expect_matches_references(const Pair& p, double tolerance) {
@@ -140,20 +149,8 @@ TEST(CapsuleProximity, GradientMatchesCentralDifferences) {
     const Eigen::Matrix<double, 14, 1> gradient = fused(p).gradient;
     for (int j = 0; j < 14; ++j) {
       const double step = 1e-6;
-      const auto phi_at = [&](double delta) {
-        Eigen::Vector3d r_a = p.pose_a.r(), r_b = p.pose_b.r();
-        Eigen::Vector4d q_a = p.pose_a.q(), q_b = p.pose_b.q();
-        if (j < 3)
-          r_a(j) += delta;
-        else if (j < 7)
-          q_a(j - 3) += delta;
-        else if (j < 10)
-          r_b(j - 7) += delta;
-        else
-          q_b(j - 10) += delta;
-        return proximity(p.a, Pose(r_a, q_a), p.b, Pose(r_b, q_b)).phi;
-      };
-      const double difference = (phi_at(step) - phi_at(-step)) / (2 * step);
+      const double difference =
+          (fused(nudged(p, j, step)).phi - fused(nudged(p, j, -step)).phi) / (2 * step);
       ASSERT_NEAR(gradient(j), difference, 1e-6 * (1 + std::abs(difference)))
           << "pair " << i << ", entry " << j;
     }
@@ -171,10 +168,9 @@ TEST(CapsuleProximity, JacobiansMatchCentralDifferences) {
     const Pair p = random_pair(rng, 1.0);
     if (!generic(p)) continue;
     const ProximityJacobian jacobian = proximity_jacobian(p.a, p.pose_a, p.b, p.pose_b);
-    const ClosestPair brute = brute_force_closest(to_world(as_test_shape(p.a), p.pose_a),
-                                                  to_world(as_test_shape(p.b), p.pose_b));
     const WorldCore ends_a = to_world(as_test_shape(p.a), p.pose_a);
     const WorldCore ends_b = to_world(as_test_shape(p.b), p.pose_b);
+    const ClosestPair brute = brute_force_closest(ends_a, ends_b);
     const auto at_an_end = [](const Vec3L& point, const WorldCore& core) {
       return (point - core.vertices[0]).norm() < 1e-9 || (point - core.vertices[1]).norm() < 1e-9;
     };
@@ -182,27 +178,15 @@ TEST(CapsuleProximity, JacobiansMatchCentralDifferences) {
             static_cast<int>(at_an_end(brute.p2, ends_b))];
     for (int j = 0; j < 14; ++j) {
       const double step = 1e-6;
-      const auto at = [&](double delta) {
-        Eigen::Vector3d r_a = p.pose_a.r(), r_b = p.pose_b.r();
-        Eigen::Vector4d q_a = p.pose_a.q(), q_b = p.pose_b.q();
-        if (j < 3)
-          r_a(j) += delta;
-        else if (j < 7)
-          q_a(j - 3) += delta;
-        else if (j < 10)
-          r_b(j - 7) += delta;
-        else
-          q_b(j - 10) += delta;
-        return proximity(p.a, Pose(r_a, q_a), p.b, Pose(r_b, q_b));
-      };
-      const Proximity plus = at(step), minus = at(-step);
-      for (int c = 0; c < 2; ++c) {
+      const Proximity plus = fused(nudged(p, j, step)), minus = fused(nudged(p, j, -step));
+      for (const Eigen::Index c : {0, 1}) {
         const Eigen::Vector3d core = (plus.core_points[c] - minus.core_points[c]) / (2 * step);
         const Eigen::Vector3d surface = (plus.points[c] - minus.points[c]) / (2 * step);
-        ASSERT_LT((jacobian.core_points_jacobian.block<3, 1>(3 * c, j) - core).norm(),
+        const Eigen::Index row = 3 * c;
+        ASSERT_LT((jacobian.core_points_jacobian.block<3, 1>(row, j) - core).norm(),
                   1e-6 * (1 + core.norm()))
             << "pair " << i << ", point " << c << ", entry " << j;
-        ASSERT_LT((jacobian.points_jacobian.block<3, 1>(3 * c, j) - surface).norm(),
+        ASSERT_LT((jacobian.points_jacobian.block<3, 1>(row, j) - surface).norm(),
                   1e-6 * (1 + surface.norm()))
             << "pair " << i << ", point " << c << ", entry " << j;
       }
