@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "point_motion.hpp"
+#include "unit_quaternion.hpp"
 
 namespace diffpills::detail {
 namespace {
@@ -65,14 +66,16 @@ inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3
 // The generic case solved in the frame (below), what both results are built from.
 struct GenericSolution {
   AxisAttitude attitude_a, attitude_b;
-  double scale;       // the frame's power of two
-  double h, k;        // half lengths in the frame
-  double s, t;        // the closest points' offsets from the middles along u and v, in the frame
-  Eigen::Vector3d n;  // u x v
-  double sin2;        // |u x v|^2
-  double cos;         // u . v
-  Eigen::Vector3d D;  // p1 - p2 in the frame
-  double D2;          // |D|^2
+  double scale;         // the frame's power of two
+  double h, k;          // half lengths in the frame
+  double s, t;          // the closest points' offsets from the middles along u and v, in the frame
+  Eigen::Vector3d n;    // u x v
+  double sin2;          // |u x v|^2
+  double cos;           // u . v
+  bool s_free, t_free;  // s, t strictly inside their segments
+  bool edge_normal;     // the normal is the edges' -+(u x v) / |u x v| (fill_proximity)
+  Eigen::Vector3d D;    // p1 - p2 in the frame
+  double D2;            // |D|^2
 };
 
 // In the frame (lengths divided by scale = 2^e, pair_frame.hpp), the capsules' cores are
@@ -132,6 +135,9 @@ struct GenericSolution {
   out.n = Eigen::Vector3d(nx, ny, nz);
   out.sin2 = sin2, out.cos = cos;
   out.D = D, out.D2 = D2;
+  out.s_free = s > -h && s < h;
+  out.t_free = t > -k && t < k;
+  out.edge_normal = out.s_free && out.t_free && sin2 >= D2;
   return true;
 }
 
@@ -156,8 +162,7 @@ struct GenericSolution {
   // to ~eps / sin, where D / |D| carries s's rounding, ~eps |w| / (sin^2 |D|) (up to 2e-13 at
   // sin^2 = 1e-2 and |D| = 1e-2: a hostile review measured 1.7e-13); taken where that is the
   // smaller error, sin >= |D|. Otherwise D is exact to a few eps S and D / |D| to eps S / |D|.
-  const bool inside_both = g.s > -g.h && g.s < g.h && g.t > -g.k && g.t < g.k;
-  if (inside_both && g.sin2 >= g.D2) {
+  if (g.edge_normal) {
     result.normal = g.n * ((g.n.dot(g.D) > 0.0 ? -1.0 : 1.0) / std::sqrt(g.sin2));
   } else {
     result.normal = g.D * (-1.0 / std::sqrt(g.D2));
@@ -185,14 +190,22 @@ Eigen::Matrix<double, 3, 4> axis_jacobian(const AxisAttitude& q) {
 // T = scale t, Delta = p1 - p2 = scale D, p1 = r_a + S u(q_a), p2 = r_b + T v(q_b):
 //   held S, T: dp1 = [I, S Ju, 0, 0], dp2 = [0, 0, I, T Jv]  (Ju = du/dq_a, Jv = dv/dq_b).
 // A free S (strictly inside its segment) keeps u . Delta = 0, a free T keeps v . Delta = 0.
-// Differentiating, with u . Ju = 0 = v . Jv (unit axes):
-//   d(u . Delta) = a + dS - cos dT,  a = [u', Delta' Ju, -u', -T u' Jv],
-//   d(v . Delta) = b + cos dS - dT,  b = [v', S v' Ju, -v', Delta' Jv],
-// so both free: dS = (cos b - a) / sin^2, dT = (b - cos a) / sin^2 (1 - cos^2 = sin^2 > 1e-2);
-// S alone: dS = -a; T alone: dT = b; neither (two ends): both zero. Then
-// dp1 += u dS, dp2 += v dT, and the normal n = -Delta / |Delta| moves by
-// dn = (I - n n') (dp2 - dp1) / |Delta|; the surface points p1 + R_a n, p2 - R_b n (the
-// implicit function theorem of point_motion.hpp, for this one case in closed form).
+// Differentiating:
+//   d(u . Delta) = a + (u . u) dS - cos dT,  a = [u', Delta' Ju + S u' Ju, -u', -T u' Jv],
+//   d(v . Delta) = b + cos dS - (v . v) dT,  b = [v', S v' Ju, -v', Delta' Jv - T v' Jv],
+// so both free: dS = (cos b - (v . v) a) / sin^2, dT = ((u . u) b - cos a) / sin^2, with
+// (u . u)(v . v) - cos^2 = |u x v|^2 = sin^2 (Lagrange's identity, > 1e-2); S alone:
+// dS = -a / (u . u); T alone: dT = b / (v . v); neither (two ends): both zero. The computed axes
+// are unit only to ~1e-15, so u . u, v . v and u' Ju, v' Jv are kept: taking them as 1 and 0, a
+// hostile review measured dS, dT off by ~1e-13 (1 / sin^2 times the axes' rounding). Then
+// dp1 += u dS, dp2 += v dT, and the surface points p1 + R_a n, p2 - R_b n move with the normal:
+//   the edges' normal n = sign (u x v) / |u x v| (fill_proximity): dn = sign (I - n n')
+//     (-[v]x Ju dq_a + [u]x Jv dq_b) / |u x v|, exactly zero along the positions (from
+//     (I - n n') (dp2 - dp1) / |Delta| instead, the review found R / |Delta| times dS's rounding,
+//     7e-11 at R = 2, |Delta| = 0.01);
+//   n = -Delta / |Delta|: dn = (I - n n') (dp2 - dp1) / |Delta|.
+// (The implicit function theorem of point_motion.hpp and contact_normal.cpp's normal motion, for
+// this one case in closed form.)
 inline void fill_jacobians(const GenericSolution& g, const Capsule& a, const Capsule& b,
                            ProximityJacobian& result) {
   using Row = Eigen::Matrix<double, 1, 14>;
@@ -202,20 +215,22 @@ inline void fill_jacobians(const GenericSolution& g, const Capsule& a, const Cap
   const Eigen::Vector3d delta = g.scale * g.D;
   const Eigen::Matrix<double, 3, 4> Ju = axis_jacobian(g.attitude_a);
   const Eigen::Matrix<double, 3, 4> Jv = axis_jacobian(g.attitude_b);
-  const bool s_free = g.s > -g.h && g.s<g.h, t_free = g.t> - g.k && g.t < g.k;
   Row dS = Row::Zero(), dT = Row::Zero();
-  if (s_free || t_free) {
+  if (g.s_free || g.t_free) {
+    const double uu = u.squaredNorm(), vv = v.squaredNorm();
     Row a_row, b_row;
-    a_row << u.transpose(), delta.transpose() * Ju, -u.transpose(), -T * (u.transpose() * Jv);
-    b_row << v.transpose(), S * (v.transpose() * Ju), -v.transpose(), delta.transpose() * Jv;
-    if (s_free && t_free) {
+    a_row << u.transpose(), (delta + S * u).transpose() * Ju, -u.transpose(),
+        -T * (u.transpose() * Jv);
+    b_row << v.transpose(), S * (v.transpose() * Ju), -v.transpose(),
+        (delta - T * v).transpose() * Jv;
+    if (g.s_free && g.t_free) {
       const double inverse_sin2 = 1.0 / g.sin2;
-      dS = (g.cos * b_row - a_row) * inverse_sin2;
-      dT = (b_row - g.cos * a_row) * inverse_sin2;
-    } else if (s_free) {
-      dS = -a_row;
+      dS = (g.cos * b_row - vv * a_row) * inverse_sin2;
+      dT = (uu * b_row - g.cos * a_row) * inverse_sin2;
+    } else if (g.s_free) {
+      dS = -a_row / uu;
     } else {
-      dT = b_row;
+      dT = b_row / vv;
     }
   }
   Matrix3x14 dp1 = u * dS, dp2 = v * dT;
@@ -224,8 +239,15 @@ inline void fill_jacobians(const GenericSolution& g, const Capsule& a, const Cap
   dp2.block<3, 3>(0, 7) += Eigen::Matrix3d::Identity();
   dp2.block<3, 4>(0, 10) += T * Jv;
   const Eigen::Vector3d& n = result.normal;
-  const Matrix3x14 dn =
-      (dp2 - dp1 - n * (n.transpose() * (dp2 - dp1))) * (1.0 / (g.scale * std::sqrt(g.D2)));
+  Matrix3x14 dn = Matrix3x14::Zero();
+  if (g.edge_normal) {
+    dn.block<3, 4>(0, 3) = -skew(v) * Ju;  // d(u x v) = du x v + u x dv
+    dn.block<3, 4>(0, 10) = skew(u) * Jv;
+    const double sign = n.dot(g.n) > 0.0 ? 1.0 : -1.0;
+    dn = (dn - n * (n.transpose() * dn)) * (sign / std::sqrt(g.sin2));
+  } else {
+    dn = (dp2 - dp1 - n * (n.transpose() * (dp2 - dp1))) * (1.0 / (g.scale * std::sqrt(g.D2)));
+  }
   result.core_points_jacobian.topRows<3>() = dp1;
   result.core_points_jacobian.bottomRows<3>() = dp2;
   result.points_jacobian.topRows<3>() = dp1 + a.radius() * dn;

@@ -20,6 +20,9 @@
 //     the features there, and decides intersection). The normal follows contact_normal.hpp's rule
 //     as the general pipeline does: -+(u x v) / |u x v| for two points inside their segments
 //     where sin >= |D|, else D / |D|, exact to a few eps S / |D| (~1e-14) once an end is held.
+//     (|D| in this frame, whose power of two comes from the largest offset component rather than
+//     the offset's length, so near sin = |D| the two paths may pick differently between two
+//     normals that agree to ~1e-15.)
 // Everything else (about 0.5% of random poses) returns false and the caller takes the general
 // pipeline. Lengths are divided by 2^e, so a scene scaled by 2^k gives the
 // same bits scaled as the general pipeline's results do (pair_frame.hpp), and the case test is
