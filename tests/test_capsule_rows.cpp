@@ -65,6 +65,13 @@ Answers kernel(const CapsulePair& pair, const Rows& rows) {
   return answers;
 }
 
+// The kernel's description of two test capsules.
+CapsulePair capsule_pair(const TestShape& a, const TestShape& b, CapsuleMeasure measure) {
+  const auto& capsule_a = std::get<Capsule>(a.shape);
+  const auto& capsule_b = std::get<Capsule>(b.shape);
+  return {capsule_a.length(), capsule_a.radius(), capsule_b.length(), capsule_b.radius(), measure};
+}
+
 // The scene's size of row i: the largest of the lengths, the radii's sum and the distance between
 // the capsules' middles (the scale of the tolerances).
 double scene_size(const CapsulePair& pair, const Rows& rows, Eigen::Index i) {
@@ -96,11 +103,8 @@ TEST(CapsuleRows, AnsweredRowsMatchBruteForceAndTheScalarPath) {
     Rng rng(401);
     for (const double scale : {0x1p-20, 1.0, 0x1p20}) {
       const TestShape a = random_capsule(rng, scale), b = random_capsule(rng, scale);
-      const auto& capsule_a = std::get<Capsule>(a.shape);
-      const auto& capsule_b = std::get<Capsule>(b.shape);
       for (const CapsuleMeasure measure : {CapsuleMeasure::kPhi, CapsuleMeasure::kSignedDistance}) {
-        const CapsulePair pair{capsule_a.length(), capsule_a.radius(), capsule_b.length(),
-                               capsule_b.radius(), measure};
+        const CapsulePair pair = capsule_pair(a, b, measure);
         ASSERT_TRUE(detail::capsule_rows_apply(pair));
         const Rows rows = random_rows(rng, 1'500, 1.5 * scale);
         const Answers answers = kernel(pair, rows);
@@ -161,11 +165,8 @@ TEST(CapsuleRows, SwapRigidMotionAndPowerOfTwoScaling) {
   on_every_target([] {
     Rng rng(404);
     const TestShape a = random_capsule(rng, 1.0), b = random_capsule(rng, 1.0);
-    const auto& capsule_a = std::get<Capsule>(a.shape);
-    const auto& capsule_b = std::get<Capsule>(b.shape);
     for (const CapsuleMeasure measure : {CapsuleMeasure::kPhi, CapsuleMeasure::kSignedDistance}) {
-      const CapsulePair pair{capsule_a.length(), capsule_a.radius(), capsule_b.length(),
-                             capsule_b.radius(), measure};
+      const CapsulePair pair = capsule_pair(a, b, measure);
       const CapsulePair swapped{pair.length_b, pair.radius_b, pair.length_a, pair.radius_a,
                                 measure};
       const int lengths = measure == CapsuleMeasure::kPhi ? 2 : 1;
@@ -228,11 +229,8 @@ TEST(CapsuleRows, GradientsMatchCentralDifferences) {
   on_every_target([] {
     Rng rng(402);
     const TestShape a = random_capsule(rng, 1.0), b = random_capsule(rng, 1.0);
-    const auto& capsule_a = std::get<Capsule>(a.shape);
-    const auto& capsule_b = std::get<Capsule>(b.shape);
     for (const CapsuleMeasure measure : {CapsuleMeasure::kPhi, CapsuleMeasure::kSignedDistance}) {
-      const CapsulePair pair{capsule_a.length(), capsule_a.radius(), capsule_b.length(),
-                             capsule_b.radius(), measure};
+      const CapsulePair pair = capsule_pair(a, b, measure);
       const Rows rows = random_rows(rng, 200, 1.5);
       const Answers answers = kernel(pair, rows);
       for (Eigen::Index i = 0; i < rows.size(); ++i) {

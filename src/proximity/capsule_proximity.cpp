@@ -67,7 +67,6 @@ inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3
 struct GenericSolution {
   AxisAttitude attitude_a, attitude_b;
   double scale;         // the frame's power of two
-  double h, k;          // half lengths in the frame
   double s, t;          // the closest points' offsets from the middles along u and v, in the frame
   Eigen::Vector3d n;    // u x v
   double sin2;          // |u x v|^2
@@ -131,7 +130,7 @@ struct GenericSolution {
   // a few eps S, is exact to ~1e-13 (capsule_proximity.hpp).
   if (!(D2 > 1e-4)) return false;
   out.scale = scale;
-  out.h = h, out.k = k, out.s = s, out.t = t;
+  out.s = s, out.t = t;
   out.n = Eigen::Vector3d(nx, ny, nz);
   out.sin2 = sin2, out.cos = cos;
   out.D = D, out.D2 = D2;
