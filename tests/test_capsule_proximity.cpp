@@ -1,12 +1,12 @@
-// proximity() and proximity_jacobian() of two capsules in the generic case take a fused pass
-// (src/proximity/capsule_proximity.hpp) instead of the general pipeline. Checked here against
-// references that share none of its code: a long-double brute force (phi, the closest points, the
-// normal), the general pipeline as proximity_hessian runs it (every field, the Jacobians too),
-// central differences (the gradient, the points' Jacobians); and by properties: a scene scaled by
-// 2^k scales every result exactly, swapping the capsules swaps the results, a rigid motion leaves
-// phi. Rows on both sides of each boundary of the generic case (nearly parallel axes, close cores,
-// short capsules, tiny scenes) agree with the brute force too, so nothing jumps where the path
-// changes.
+// proximity(), proximity_jacobian() and proximity_hessian() of two capsules in the generic case
+// take a fused pass (src/proximity/capsule_proximity.hpp) instead of the general pipeline. Checked
+// here against references that share none of its code: a long-double brute force (phi, the
+// closest points, the normal), the general pipeline (every field, the Jacobians and the Hessian
+// too), central differences (the gradient, the points' Jacobians, the Hessian); and by
+// properties: a scene scaled by 2^k scales every result exactly, swapping the capsules swaps the
+// results, a rigid motion leaves phi. Rows on both sides of each boundary of the generic case
+// (nearly parallel axes, close cores, short capsules, tiny scenes) agree with the brute force too,
+// so nothing jumps where the path changes.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -55,10 +55,11 @@ Pair nudged(const Pair& p, int j, double delta) {
 }
 
 // Every field of the fused answer against the long-double brute force and against the general
-// pipeline (proximity_hessian, which always takes it), relative to the scene's size S.
+// pipeline, relative to the scene's size S.
 void expect_matches_references(const Pair& p, double tolerance) {
   const Proximity fast = fused(p);
-  const ProximityHessian general = proximity_hessian(p.a, p.pose_a, p.b, p.pose_b);
+  const ProximityHessian general =
+      detail::general_capsule_proximity_hessian(p.a, p.pose_a, p.b, p.pose_b);
   const ClosestPair brute = brute_force_closest(to_world(as_test_shape(p.a), p.pose_a),
                                                 to_world(as_test_shape(p.b), p.pose_b));
   const double S = scene_size(p);
@@ -112,6 +113,24 @@ void expect_matches_references(const Pair& p, double tolerance) {
           << row << ", " << column;
     }
   }
+  // The Hessian (through the Shape overload, as every caller reaches it): its Jacobian part is
+  // the same pass's, bit for bit; phi's Hessian against the general pipeline's, each index in
+  // its unit (1 for a position, S / |q| for a quaternion component).
+  const ProximityHessian second = proximity_hessian(Shape(p.a), p.pose_a, Shape(p.b), p.pose_b);
+  ASSERT_EQ(second.phi, fast.phi);
+  ASSERT_EQ(second.gradient, fast.gradient);
+  ASSERT_EQ(second.core_points_jacobian, jacobian.core_points_jacobian);
+  ASSERT_EQ(second.points_jacobian, jacobian.points_jacobian);
+  const auto index_unit = [&](int index) {
+    return index % 7 < 3 ? 1.0 : S / (index < 7 ? p.pose_a : p.pose_b).q().norm();
+  };
+  for (int row = 0; row < 14; ++row) {
+    for (int column = 0; column < 14; ++column) {
+      ASSERT_NEAR(second.hessian(row, column), general.hessian(row, column),
+                  tolerance * index_unit(row) * index_unit(column))
+          << row << ", " << column;
+    }
+  }
 }
 
 Pair random_pair(Rng& rng, double scale) {
@@ -158,9 +177,22 @@ TEST(CapsuleProximity, GradientMatchesCentralDifferences) {
   EXPECT_GT(checked, 250);
 }
 
+// How many of the two closest points lie at an end of their segment (0, 1 or 2), from the
+// brute force's points.
+int ends_held(const Pair& p) {
+  const WorldCore ends_a = to_world(as_test_shape(p.a), p.pose_a);
+  const WorldCore ends_b = to_world(as_test_shape(p.b), p.pose_b);
+  const ClosestPair brute = brute_force_closest(ends_a, ends_b);
+  const auto at_an_end = [](const Vec3L& point, const WorldCore& core) {
+    return (point - core.vertices[0]).norm() < 1e-9 || (point - core.vertices[1]).norm() < 1e-9;
+  };
+  return static_cast<int>(at_an_end(brute.p1, ends_a)) +
+         static_cast<int>(at_an_end(brute.p2, ends_b));
+}
+
 // Central differences of the surface and core points (proximity(), the fused pass's own points)
 // against proximity_jacobian's Jacobians, on pairs of each kind of closest points: both inside
-// their segments, one at an end, both at ends (counted from the brute force's points).
+// their segments, one at an end, both at ends.
 TEST(CapsuleProximity, JacobiansMatchCentralDifferences) {
   Rng rng(1306);
   int kinds[3] = {0, 0, 0};  // closest points at 0, 1 or 2 segment ends
@@ -168,14 +200,7 @@ TEST(CapsuleProximity, JacobiansMatchCentralDifferences) {
     const Pair p = random_pair(rng, 1.0);
     if (!generic(p)) continue;
     const ProximityJacobian jacobian = proximity_jacobian(p.a, p.pose_a, p.b, p.pose_b);
-    const WorldCore ends_a = to_world(as_test_shape(p.a), p.pose_a);
-    const WorldCore ends_b = to_world(as_test_shape(p.b), p.pose_b);
-    const ClosestPair brute = brute_force_closest(ends_a, ends_b);
-    const auto at_an_end = [](const Vec3L& point, const WorldCore& core) {
-      return (point - core.vertices[0]).norm() < 1e-9 || (point - core.vertices[1]).norm() < 1e-9;
-    };
-    ++kinds[static_cast<int>(at_an_end(brute.p1, ends_a)) +
-            static_cast<int>(at_an_end(brute.p2, ends_b))];
+    ++kinds[ends_held(p)];
     for (int j = 0; j < 14; ++j) {
       const double step = 1e-6;
       const Proximity plus = fused(nudged(p, j, step)), minus = fused(nudged(p, j, -step));
@@ -193,6 +218,43 @@ TEST(CapsuleProximity, JacobiansMatchCentralDifferences) {
     }
   }
   for (const int count : kinds) EXPECT_GT(count, 20);
+}
+
+// Central differences of the fused gradient against the fused Hessian, on each kind of closest
+// points. Where the differences at two steps disagree, the clamping changes within the step (a
+// kink, where phi is not twice differentiable): skipped and counted.
+TEST(CapsuleProximity, HessianMatchesCentralDifferencesOfTheGradient) {
+  using Vector14 = Eigen::Matrix<double, 14, 1>;
+  Rng rng(1307);
+  int kinds[3] = {0, 0, 0}, kinks = 0;
+  for (int i = 0; i < 400; ++i) {
+    const Pair p = random_pair(rng, 1.0);
+    if (!generic(p)) continue;
+    const ProximityHessian exact = proximity_hessian(Shape(p.a), p.pose_a, Shape(p.b), p.pose_b);
+    Eigen::Matrix<double, 14, 14> numeric;
+    bool smooth = true;
+    for (int j = 0; j < 14 && smooth; ++j) {
+      const auto column = [&](double step) {
+        return Vector14((fused(nudged(p, j, step)).gradient - fused(nudged(p, j, -step)).gradient) /
+                        (2 * step));
+      };
+      const Vector14 coarse = column(1e-5), fine = column(2.5e-6);
+      smooth = (coarse - fine).cwiseAbs().maxCoeff() <= 1e-5 * (1 + fine.cwiseAbs().maxCoeff());
+      numeric.col(j) = fine;
+    }
+    if (!smooth) {
+      ++kinks;
+      continue;
+    }
+    ++kinds[ends_held(p)];
+    ASSERT_LE((exact.hessian - numeric).cwiseAbs().maxCoeff(),
+              1e-6 * (1 + numeric.cwiseAbs().maxCoeff()))
+        << "pair " << i << "\nexact\n"
+        << exact.hessian << "\nnumeric\n"
+        << numeric;
+  }
+  for (const int count : kinds) EXPECT_GT(count, 20);
+  EXPECT_LT(kinks, 20);
 }
 
 Pose scaled(const Pose& pose, int k) { return Pose(std::ldexp(1.0, k) * pose.r(), pose.q()); }
@@ -227,6 +289,38 @@ TEST(CapsuleProximity, ScalingByAPowerOfTwoIsExact) {
   }
 }
 
+// The same for the Jacobians (position columns unitless, quaternion columns a length) and phi's
+// Hessian (one length per quaternion index), for every k that keeps the Hessian's quaternion
+// block, of order 2^2k, a normal number.
+TEST(CapsuleProximity, SecondOrderScalingByAPowerOfTwoIsExact) {
+  Rng rng(1308);
+  for (int i = 0; i < 200; ++i) {
+    const Pair p = random_pair(rng, 1.0);
+    const ProximityHessian base = proximity_hessian(Shape(p.a), p.pose_a, Shape(p.b), p.pose_b);
+    for (const int k : {-300, -13, 13, 300, 325}) {
+      const double f = std::ldexp(1.0, k);
+      const ProximityHessian result =
+          proximity_hessian(Capsule(f * p.a.length(), f * p.a.radius()), scaled(p.pose_a, k),
+                            Capsule(f * p.b.length(), f * p.b.radius()), scaled(p.pose_b, k));
+      for (int column = 0; column < 14; ++column) {
+        const bool rotation_column = column % 7 >= 3;
+        for (int row = 0; row < 6; ++row) {
+          ASSERT_EQ(result.points_jacobian(row, column),
+                    std::ldexp(base.points_jacobian(row, column), rotation_column ? k : 0))
+              << "pair " << i << ", k = " << k << " (" << row << ", " << column << ")";
+          ASSERT_EQ(result.core_points_jacobian(row, column),
+                    std::ldexp(base.core_points_jacobian(row, column), rotation_column ? k : 0));
+        }
+        for (int row = 0; row < 14; ++row) {
+          const int power = static_cast<int>(rotation_column) + static_cast<int>(row % 7 >= 3);
+          ASSERT_EQ(result.hessian(row, column), std::ldexp(base.hessian(row, column), power * k))
+              << "pair " << i << ", k = " << k << " (" << row << ", " << column << ")";
+        }
+      }
+    }
+  }
+}
+
 TEST(CapsuleProximity, SwappingTheCapsulesSwapsTheResults) {
   Rng rng(1304);
   for (int i = 0; i < 1'000; ++i) {
@@ -243,6 +337,19 @@ TEST(CapsuleProximity, SwappingTheCapsulesSwapsTheResults) {
     for (int j = 0; j < 7; ++j) {
       ASSERT_NEAR(ab.gradient(j), ba.gradient(7 + j), 1e-13 * S * S * (1 + S));
       ASSERT_NEAR(ab.gradient(7 + j), ba.gradient(j), 1e-13 * S * S * (1 + S));
+    }
+    // phi's Hessian: the blocks of [r1 q1] and [r2 q2] trade places.
+    const ProximityHessian second_ab =
+        proximity_hessian(Shape(p.a), p.pose_a, Shape(p.b), p.pose_b);
+    const ProximityHessian second_ba =
+        proximity_hessian(Shape(p.b), p.pose_b, Shape(p.a), p.pose_a);
+    const double size = second_ab.hessian.cwiseAbs().maxCoeff();
+    for (int row = 0; row < 14; ++row) {
+      for (int column = 0; column < 14; ++column) {
+        ASSERT_NEAR(second_ab.hessian(row, column),
+                    second_ba.hessian((row + 7) % 14, (column + 7) % 14), 1e-12 * size)
+            << "pair " << i << " (" << row << ", " << column << ")";
+      }
     }
   }
 }
@@ -343,7 +450,8 @@ TEST(CapsuleProximity, InnerPointsJacobianIsExact) {
                                     0.060744655212883879, -0.17288577189825372))};
   ASSERT_TRUE(generic(p));
   const ProximityJacobian fast = proximity_jacobian(p.a, p.pose_a, p.b, p.pose_b);
-  const ProximityHessian general = proximity_hessian(p.a, p.pose_a, p.b, p.pose_b);
+  const ProximityHessian general =
+      detail::general_capsule_proximity_hessian(p.a, p.pose_a, p.b, p.pose_b);
   const double q_norm_b = p.pose_b.q().norm();  // 0.19: q_b's columns are 5x larger
   for (int column = 0; column < 14; ++column) {
     const double unit = column >= 10 ? 1.0 / q_norm_b : 1.0;
@@ -369,7 +477,8 @@ TEST(CapsuleProximity, QuaternionGradientOfATinySceneDoesNotUnderflow) {
                     2e-40 * Eigen::Vector4d(std::sqrt(0.5), 0, 0, std::sqrt(0.5)))};
   ASSERT_TRUE(generic(p));
   const Proximity fast = fused(p);
-  const ProximityHessian general = proximity_hessian(p.a, p.pose_a, p.b, p.pose_b);
+  const ProximityHessian general =
+      detail::general_capsule_proximity_hessian(p.a, p.pose_a, p.b, p.pose_b);
   for (int j = 3; j < 7; ++j) {
     EXPECT_NEAR(fast.gradient(j), general.gradient(j), 1e-12 * std::abs(general.gradient(j)));
   }

@@ -89,10 +89,10 @@ namespace diffpills {
 enum class Method {
   // Exact fast paths: two segments in closed form (Appendix A's candidates), pairs with a polygon
   // by enumerating feature pairs in a polygon's body frame. No heap allocation for polygons of up
-  // to 32 vertices. proximity() and proximity_jacobian() of two capsules whose axes are more
-  // than ~5.7 degrees apart and whose cores are apart by more than ~1e-2 of the scene take one
-  // fused pass (src/proximity/capsule_proximity.hpp); proximity_hessian always takes the general
-  // one, so its other fields agree with theirs to rounding (1e-13 of the scene), not bit for bit.
+  // to 32 vertices. proximity(), proximity_jacobian() and proximity_hessian() of two capsules
+  // whose axes are more than ~5.7 degrees apart and whose cores are apart by more than ~1e-2 of
+  // the scene take one fused pass (src/proximity/capsule_proximity.hpp), whose fields the three
+  // share bit for bit and which agrees with the general pipeline to 1e-13 of the scene.
   kDefault,
   // The paper's interior-point method (section II-B) on the pair's QP, polished to its active
   // set: slower, kept as the reference the fast paths are tested against.

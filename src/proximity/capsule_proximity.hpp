@@ -1,6 +1,6 @@
-// proximity() and proximity_jacobian() of two capsules in one pass (issue 13): the generic case
-// without the general pipeline's pair frame object, posed cores, rotation matrices, feature-based
-// normal and general implicit-function-theorem solve.
+// proximity(), proximity_jacobian() and proximity_hessian() of two capsules in one pass (issues 12
+// and 13): the generic case without the general pipeline's pair frame object, posed cores,
+// rotation matrices, feature-based normal and general implicit-function-theorem solve.
 //
 // The general pipeline (proximity.cpp) builds both cores' 3 x 3 rotations and quaternion
 // Jacobians, hands the closest points to the shared result builder as body points with free
@@ -29,19 +29,60 @@
 // scale invariant.
 #pragma once
 
+#include <Eigen/Core>
+
 #include "diffpills/proximity.hpp"
 #include "diffpills/shapes.hpp"
 
 namespace diffpills::detail {
 
+// A quaternion q as the fused pass uses it: q^ = q / |q|, 1 / |q| and the body x axis Q(q^) e_x.
+struct AxisAttitude {
+  Eigen::Vector4d unit;
+  double inverse_norm;
+  Eigen::Vector3d axis;
+};
+
+// The generic case solved in the frame (capsule_proximity.cpp's solve_generic), what every
+// result is built from.
+struct GenericCapsuleSolution {
+  AxisAttitude attitude_a, attitude_b;
+  double scale;         // the frame's power of two
+  double s, t;          // the closest points' offsets from the middles along u and v, in the frame
+  Eigen::Vector3d n;    // u x v
+  double sin2;          // |u x v|^2
+  double cos;           // u . v
+  bool s_free, t_free;  // s, t strictly inside their segments
+  bool edge_normal;     // the normal is the edges' -+(u x v) / |u x v| (fill_proximity)
+  Eigen::Vector3d D;    // p1 - p2 in the frame
+  double D2;            // |D|^2
+};
+
 // True and `result` filled in the generic case above; false (result unspecified) otherwise.
 bool generic_capsule_proximity(const Capsule& a, const Pose& pose_a, const Capsule& b,
                                const Pose& pose_b, Proximity& result);
 
-// The same, with the closest points' Jacobians: in the generic case the implicit function
-// theorem's system has at most two free coordinates (s and t along the axes), solved in closed
-// form. The Proximity part is generic_capsule_proximity's, bit for bit.
-bool generic_capsule_proximity_jacobian(const Capsule& a, const Pose& pose_a, const Capsule& b,
-                                        const Pose& pose_b, ProximityJacobian& result);
+// True and `solution` filled in the generic case; false otherwise.
+bool solve_generic_capsules(const Capsule& a, const Pose& pose_a, const Capsule& b,
+                            const Pose& pose_b, GenericCapsuleSolution& solution);
+
+// The results of a generic case's solution, with the closest points' Jacobians (the implicit
+// function theorem's system has at most two free coordinates, s and t along the axes, solved in
+// closed form) and with phi's Hessian (the second-order theorem over the same coordinates). Both
+// repeat generic_capsule_proximity's Proximity part bit for bit, and the Hessian the Jacobian's
+// part. Returned by value, built in place: each large matrix is a prvalue of the aggregate's
+// initializer, so the default member initializers never zero them first (~30 ns for the
+// Jacobians, ~45 ns with the Hessian, measured).
+ProximityJacobian generic_capsule_proximity_jacobian(const GenericCapsuleSolution& solution,
+                                                     const Capsule& a, const Pose& pose_a,
+                                                     const Capsule& b, const Pose& pose_b);
+ProximityHessian generic_capsule_proximity_hessian(const GenericCapsuleSolution& solution,
+                                                   const Capsule& a, const Pose& pose_a,
+                                                   const Capsule& b, const Pose& pose_b);
+
+// Every field by the general pipeline, whatever the case: what the fused pass is checked against
+// (tests, fuzz_proximity). Defined in proximity.cpp.
+ProximityHessian general_capsule_proximity_hessian(const Capsule& a, const Pose& pose_a,
+                                                   const Capsule& b, const Pose& pose_b);
 
 }  // namespace diffpills::detail

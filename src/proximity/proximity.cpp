@@ -2,8 +2,8 @@
 // Method::kDefault sends the pair to its exact fast solver (fast_paths.hpp) and
 // Method::kInteriorPoint builds the pair's QP (pair_problem.hpp) and solves it with the paper's
 // interior-point method. Both hand the two sides of the solution to the same result builder.
-// proximity() and proximity_jacobian() of two capsules in the generic case skip all of this for
-// one fused pass (capsule_proximity.hpp).
+// proximity(), proximity_jacobian() and proximity_hessian() of two capsules in the generic case
+// skip all of this for one fused pass (capsule_proximity.hpp).
 #include "diffpills/proximity.hpp"
 
 #include <type_traits>
@@ -92,8 +92,8 @@ Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& p
 }  // namespace
 
 // Two capsules in the generic case take one fused pass, half the general pipeline's cost
-// (capsule_proximity.hpp), and so do their Jacobians. One named result, so that it is built in
-// place.
+// (capsule_proximity.hpp), and so do their Jacobians and Hessian. Each result is built in place:
+// one named result here, prvalues for the others (returned from both branches).
 Proximity proximity(const Capsule& a, const Pose& pose_a, const Capsule& b, const Pose& pose_b,
                     const ProximityOptions& options) {
   Proximity result;
@@ -126,12 +126,12 @@ Proximity proximity(const Shape& a, const Pose& pose_a, const Shape& b, const Po
 
 ProximityJacobian proximity_jacobian(const Capsule& a, const Pose& pose_a, const Capsule& b,
                                      const Pose& pose_b, const ProximityOptions& options) {
-  ProximityJacobian result;
-  if (options.method != Method::kDefault ||
-      !detail::generic_capsule_proximity_jacobian(a, pose_a, b, pose_b, result)) {
-    result = query<ProximityJacobian>(a, pose_a, b, pose_b, options);
+  detail::GenericCapsuleSolution solution;
+  if (options.method == Method::kDefault &&
+      detail::solve_generic_capsules(a, pose_a, b, pose_b, solution)) {
+    return detail::generic_capsule_proximity_jacobian(solution, a, pose_a, b, pose_b);
   }
-  return result;
+  return query<ProximityJacobian>(a, pose_a, b, pose_b, options);
 }
 ProximityJacobian proximity_jacobian(const Capsule& a, const Pose& pose_a, const PaddedPolygon& b,
                                      const Pose& pose_b, const ProximityOptions& options) {
@@ -157,11 +157,28 @@ ProximityJacobian proximity_jacobian(const Shape& a, const Pose& pose_a, const S
 
 ProximityHessian proximity_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
                                    const Pose& pose_b, const ProximityOptions& options) {
+  const Capsule* capsule_a = std::get_if<Capsule>(&a);
+  const Capsule* capsule_b = std::get_if<Capsule>(&b);
+  detail::GenericCapsuleSolution solution;
+  if (options.method == Method::kDefault && capsule_a != nullptr && capsule_b != nullptr &&
+      detail::solve_generic_capsules(*capsule_a, pose_a, *capsule_b, pose_b, solution)) {
+    return detail::generic_capsule_proximity_hessian(solution, *capsule_a, pose_a, *capsule_b,
+                                                     pose_b);
+  }
   return std::visit(
       [&](const auto& shape_a, const auto& shape_b) {
         return query<ProximityHessian>(shape_a, pose_a, shape_b, pose_b, options);
       },
       a, b);
 }
+
+namespace detail {
+
+ProximityHessian general_capsule_proximity_hessian(const Capsule& a, const Pose& pose_a,
+                                                   const Capsule& b, const Pose& pose_b) {
+  return query<ProximityHessian>(a, pose_a, b, pose_b, ProximityOptions{});
+}
+
+}  // namespace detail
 
 }  // namespace diffpills
