@@ -92,7 +92,7 @@ enum class Method {
   // to 32 vertices. proximity(), proximity_jacobian() and proximity_hessian() of two capsules
   // whose axes are more than ~5.7 degrees apart and whose cores are apart by more than ~1e-2 of
   // the scene take one fused pass (src/proximity/capsule_proximity.hpp), whose fields the three
-  // share bit for bit and which agrees with the general pipeline to 1e-13 of the scene.
+  // share bit for bit and which agrees with the general pipeline to rounding (~1e-13 relative).
   kDefault,
   // The paper's interior-point method (section II-B) on the pair's QP, polished to its active
   // set: slower, kept as the reference the fast paths are tested against.
