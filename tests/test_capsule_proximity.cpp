@@ -364,14 +364,9 @@ TEST(CapsuleProximity, RigidMotionLeavesPhi) {
     const Pair p = random_pair(rng, 1.0);
     const Eigen::Quaterniond turn = Eigen::Quaterniond::UnitRandom();
     const Eigen::Vector3d shift = Eigen::Vector3d::Random() * 4.0;
-    const auto moved = [&](const Pose& pose) {
-      const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
-      const Eigen::Quaterniond turned = turn * q;
-      return Pose(turn * pose.r() + shift,
-                  Eigen::Vector4d(turned.w(), turned.x(), turned.y(), turned.z()));
-    };
     const Proximity before = fused(p);
-    const Proximity after = proximity(p.a, moved(p.pose_a), p.b, moved(p.pose_b));
+    const Proximity after = proximity(p.a, rigidly_moved(p.pose_a, turn, shift), p.b,
+                                      rigidly_moved(p.pose_b, turn, shift));
     const double S = scene_size(p) + shift.norm();
     ASSERT_NEAR(after.phi, before.phi, 1e-13 * S * S) << "pair " << i;
     ASSERT_LT((after.normal - turn * before.normal).norm(), 1e-12) << "pair " << i;

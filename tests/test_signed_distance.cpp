@@ -305,14 +305,9 @@ TEST(SignedDistance, SwapAndRigidMotion) {
 
       const Eigen::Quaterniond turn = Eigen::Quaterniond::UnitRandom();
       const Eigen::Vector3d shift = Eigen::Vector3d::Random() * 3.0;
-      const auto rigid = [&](const Pose& pose) {
-        const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
-        const Eigen::Quaterniond turned = turn * q;
-        return Pose(turn * pose.r() + shift,
-                    Eigen::Vector4d(turned.w(), turned.x(), turned.y(), turned.z()));
-      };
       const SignedDistance moved_pair =
-          signed_distance(c.a.shape, rigid(c.pose_a), c.b.shape, rigid(c.pose_b));
+          signed_distance(c.a.shape, rigidly_moved(c.pose_a, turn, shift), c.b.shape,
+                          rigidly_moved(c.pose_b, turn, shift));
       ASSERT_NEAR(moved_pair.distance, ab.distance, 1e-11) << name(pair) << " case " << i;
       EXPECT_LE((moved_pair.normal - turn * ab.normal).norm(), 1e-8);
       EXPECT_LE((moved_pair.points[0] - (turn * ab.points[0] + shift)).norm(), 1e-8);

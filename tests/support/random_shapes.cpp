@@ -103,6 +103,13 @@ Pose random_pose(Rng& rng, double spread) {
   return Pose(r, q);
 }
 
+Pose rigidly_moved(const Pose& pose, const Eigen::Quaterniond& turn, const Eigen::Vector3d& shift) {
+  const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
+  const Eigen::Quaterniond turned = turn * q;
+  return Pose(turn * pose.r() + shift,
+              Eigen::Vector4d(turned.w(), turned.x(), turned.y(), turned.z()));
+}
+
 WorldCore to_world(const TestShape& shape, const Pose& pose) {
   const Eigen::Quaternion<long double> rotation(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
   const Eigen::Matrix<long double, 3, 3> R = rotation.normalized().toRotationMatrix();

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <random>
 #include <vector>
 
@@ -31,6 +32,10 @@ TestShape random_polygon(Rng& rng, double scale);
 
 // Uniform position in [-spread, spread]^3 and a random quaternion of norm in [0.5, 2].
 Pose random_pose(Rng& rng, double spread);
+
+// The pose after a rigid motion of the whole scene: turned by `turn` about the world origin, then
+// shifted (the attitude turn * q, q's norm kept).
+Pose rigidly_moved(const Pose& pose, const Eigen::Quaterniond& turn, const Eigen::Vector3d& shift);
 
 // The core in world coordinates, through Eigen's own quaternion rotation in long double.
 WorldCore to_world(const TestShape& shape, const Pose& pose);
