@@ -26,8 +26,9 @@ void restore_units(const PairFrame& frame, Proximity& result) {
   const double s = frame.scale;
   result.phi = result.phi * s * s;  // two products: s * s alone may underflow where phi does not
   result.gradient.segment<3>(0) *= s;
-  // The quaternion parts by two products too: s * s underflows below 2^-537 where they do not
-  // (a hostile review: a scene of 2^-538 with |q| = 2e-40 lost its quaternion gradient).
+  // The quaternion parts by two products too: s * s goes subnormal below 2^-511 and is zero
+  // below 2^-537, where they are neither (a hostile review: a scene of 2^-538 with |q| = 2e-40
+  // lost its quaternion gradient).
   result.gradient.segment<4>(3) = result.gradient.segment<4>(3) * s * s;
   result.gradient.segment<3>(7) *= s;
   result.gradient.segment<4>(10) = result.gradient.segment<4>(10) * s * s;
