@@ -103,15 +103,17 @@ TEST(ArmShelf, ConstraintJacobiansMatchCentralDifferences) {
   int checked = 0, near = 0;
   const std::vector<Eigen::VectorXd> guess = problem.retreat_controls();
   for (int k = 0; k < s.knots; ++k) {
-    Eigen::VectorXd state = x, control = Eigen::VectorXd::Zero(k + 1 < s.knots ? 7 : 0);
+    // The last knot has no control: the problem gets zero there and its du is not checked.
+    const int control_columns = k + 1 < s.knots ? 7 : 0;
+    Eigen::VectorXd state = x, control = Eigen::VectorXd::Zero(7);
     for (int i = 0; i < 7; ++i) state(i) += noise(rng);
     if (k + 1 < s.knots) {
       control = guess[static_cast<std::size_t>(k)];
       for (int i = 0; i < 7; ++i) control(i) += noise(rng);
     }
-    const trajopt::KnotConstraints exact = problem.constraints(k, state, control);
+    const ArmShelfProblem::Constraints exact = problem.constraints(k, state, control);
     const double h = 1e-6;
-    for (int column = 0; column < 7 + control.size(); ++column) {
+    for (int column = 0; column < 7 + control_columns; ++column) {
       Eigen::VectorXd xp = state, xm = state, up = control, um = control;
       if (column < 7) {
         xp(column) += h, xm(column) -= h;

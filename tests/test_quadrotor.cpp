@@ -128,7 +128,7 @@ TEST_P(WindowConstraintGradients, MatchCentralDifferences) {
     State x = random_state(rng);
     const double along = trial % 3 == 0 ? 1.5 : (trial % 3 == 1 ? 3.0 : 4.5);
     x.head<3>() = Vector3d(along, 0.0, 1.5) + 0.6 * Vector3d(unit(rng), unit(rng), unit(rng));
-    const KnotConstraints c = problem.constraints(0, x, u);
+    const examples::QuadrotorWindowProblem::Constraints c = problem.constraints(0, x, u);
     MatrixXd numeric(c.value.size(), 13);
     for (int j = 0; j < 13; ++j) {
       State plus = x, minus = x;

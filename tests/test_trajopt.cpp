@@ -5,13 +5,16 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <random>
+#include <string>
 
 #include "car_bus/car_bus.hpp"
 #include "car_bus/car_bus_ipopt.hpp"
 #include "diffpills/trajopt/altro.hpp"
 #include "diffpills/trajopt/car.hpp"
+#include "diffpills/trajopt/dynamic_problem.hpp"
 #include "diffpills/trajopt/rk4.hpp"
 #include "ipopt/problem_nlp.hpp"
 
@@ -21,37 +24,58 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-// x+ = A x + B u, cost sum 1/2 x'Qx + 1/2 u'Ru + 1/2 x_N' Qf x_N, optionally with constraints.
-class LinearQuadratic : public Problem {
+// x+ = A x + B u, cost sum 1/2 x'Qx + 1/2 u'Ru + 1/2 x_N' Qf x_N, optionally with constraints;
+// with the sizes fixed at compile time or not (problem.hpp).
+template <int Nx, int Nu>
+class LinearQuadraticOf : public ProblemOf<Nx, Nu> {
  public:
-  LinearQuadratic(MatrixXd A, MatrixXd B, MatrixXd Q, MatrixXd R, MatrixXd Qf, int knots)
-      : A_(std::move(A)),
-        B_(std::move(B)),
-        Q_(std::move(Q)),
-        R_(std::move(R)),
-        Qf_(std::move(Qf)),
-        knots_(knots) {}
+  using P = ProblemOf<Nx, Nu>;
+  using typename P::Control;
+  using typename P::ControlMatrix;
+  using typename P::Cost;
+  using typename P::State;
+  using typename P::StateMatrix;
+
+  LinearQuadraticOf(const MatrixXd& A, const MatrixXd& B, const MatrixXd& Q, const MatrixXd& R,
+                    const MatrixXd& Qf, int knots)
+      : A_(A), B_(B), Q_(Q), R_(R), Qf_(Qf), knots_(knots) {}
   int state_size() const override { return static_cast<int>(A_.rows()); }
   int control_size() const override { return static_cast<int>(B_.cols()); }
   int knots() const override { return knots_; }
-  void dynamics(const VectorXd& x, const VectorXd& u, VectorXd& next, MatrixXd& A,
-                MatrixXd& B) const override {
+  void dynamics(const State& x, const Control& u, State& next, StateMatrix& A,
+                ControlMatrix& B) const override {
     next = A_ * x + B_ * u;
     A = A_;
     B = B_;
   }
-  CostExpansion stage_cost(int, const VectorXd& x, const VectorXd& u) const override {
-    return {0.5 * x.dot(Q_ * x) + 0.5 * u.dot(R_ * u), Q_ * x, R_ * u, Q_, R_,
-            MatrixXd::Zero(u.size(), x.size())};
+  Cost stage_cost(int, const State& x, const Control& u) const override {
+    return {0.5 * x.dot(Q_ * x) + 0.5 * u.dot(R_ * u),
+            Q_ * x,
+            R_ * u,
+            Q_,
+            R_,
+            Eigen::Matrix<double, Nu, Nx>::Zero(u.size(), x.size())};
   }
-  CostExpansion terminal_cost(const VectorXd& x) const override {
-    return {0.5 * x.dot(Qf_ * x), Qf_ * x, VectorXd(), Qf_, MatrixXd(), MatrixXd()};
+  Cost terminal_cost(const State& x) const override {
+    const Eigen::Index m = B_.cols();
+    return {0.5 * x.dot(Qf_ * x),
+            Qf_ * x,
+            Control::Zero(m),
+            Qf_,
+            Eigen::Matrix<double, Nu, Nu>::Zero(m, m),
+            Eigen::Matrix<double, Nu, Nx>::Zero(m, x.size())};
   }
 
  private:
-  MatrixXd A_, B_, Q_, R_, Qf_;
+  StateMatrix A_;
+  ControlMatrix B_;
+  StateMatrix Q_;
+  Eigen::Matrix<double, Nu, Nu> R_;
+  StateMatrix Qf_;
   int knots_;
 };
+
+using LinearQuadratic = LinearQuadraticOf<Eigen::Dynamic, Eigen::Dynamic>;
 
 MatrixXd random_matrix(std::mt19937_64& rng, int rows, int cols) {
   std::normal_distribution<double> normal;
@@ -61,8 +85,11 @@ MatrixXd random_matrix(std::mt19937_64& rng, int rows, int cols) {
   return m;
 }
 
-TEST(Trajopt, UnconstrainedLinearQuadraticMatchesRiccati) {
-  std::mt19937_64 rng(7);
+// ALTRO on random LQ problems (4 states, 2 controls) against the Riccati recursion, written out
+// here; Nx, Nu pick the solver's sizes, fixed or run-time.
+template <int Nx, int Nu>
+void expect_riccati_controls(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
     const int n = 4, m = 2, N = 30;
     const MatrixXd A = MatrixXd::Identity(n, n) + 0.1 * random_matrix(rng, n, n);
@@ -86,7 +113,7 @@ TEST(Trajopt, UnconstrainedLinearQuadraticMatchesRiccati) {
       riccati[k] = gains[k] * x;
       x = A * x + B * riccati[k];
     }
-    const LinearQuadratic problem(A, B, Q, R, Qf, N);
+    const LinearQuadraticOf<Nx, Nu> problem(A, B, Q, R, Qf, N);
     const AltroResult result = solve(problem, x0, std::vector<VectorXd>(N - 1, VectorXd::Zero(m)));
     ASSERT_EQ(result.status, AltroStatus::kSolved) << to_string(result.status);
     for (int k = 0; k + 1 < N; ++k) {
@@ -94,6 +121,56 @@ TEST(Trajopt, UnconstrainedLinearQuadraticMatchesRiccati) {
           << "trial " << trial << " knot " << k;
     }
     EXPECT_LE(result.iterations, 5);  // LQ: one Newton step, then the convergence check
+  }
+}
+
+TEST(Trajopt, UnconstrainedLinearQuadraticMatchesRiccati) {
+  expect_riccati_controls<Eigen::Dynamic, Eigen::Dynamic>(7);
+  expect_riccati_controls<4, 2>(7);
+}
+
+// The solver compiled for the car's sizes and the run-time-sized one (the same problem seen
+// through DynamicProblem) take the same path: same status and iterations, and states that differ
+// only by the rounding of products summed in another order.
+TEST(Trajopt, FixedAndDynamicSizesSolveTheSame) {
+  const examples::CarBusProblem problem{examples::CarBusScenario{}};
+  const DynamicProblem<5, 2> dynamic(problem);
+  const std::vector<VectorXd> guess = problem.straight_line_controls();
+  const AltroResult fixed_result = solve(problem, problem.scenario().x0, guess);
+  const AltroResult dynamic_result = solve(dynamic, problem.scenario().x0, guess);
+  ASSERT_EQ(fixed_result.status, AltroStatus::kSolved);
+  EXPECT_EQ(fixed_result.status, dynamic_result.status);
+  EXPECT_EQ(fixed_result.iterations, dynamic_result.iterations);
+  EXPECT_EQ(fixed_result.outer_iterations, dynamic_result.outer_iterations);
+  EXPECT_NEAR(fixed_result.cost, dynamic_result.cost, 1e-9 * fixed_result.cost);
+  for (std::size_t k = 0; k < fixed_result.states.size(); ++k) {
+    EXPECT_LE((fixed_result.states[k] - dynamic_result.states[k]).norm(), 1e-7) << "knot " << k;
+  }
+}
+
+// A problem whose constraint derivatives do not have one row per value is refused by name
+// instead of being read past.
+TEST(Trajopt, RefusesConstraintsOfTheWrongShape) {
+  class Misshapen : public LinearQuadratic {
+   public:
+    using LinearQuadratic::LinearQuadratic;
+    KnotConstraints constraints(int k, const VectorXd& x, const VectorXd& u) const override {
+      KnotConstraints c;
+      c.value = VectorXd::Constant(2, -1.0);
+      c.dx = MatrixXd::Zero(1, x.size());  // one row short
+      c.du = MatrixXd::Zero(k + 1 < knots() ? 2 : 1, u.size());
+      return c;
+    }
+  };
+  const Misshapen problem(MatrixXd::Identity(2, 2), MatrixXd::Identity(2, 1),
+                          MatrixXd::Identity(2, 2), MatrixXd::Identity(1, 1),
+                          MatrixXd::Identity(2, 2), 4);
+  try {
+    solve(problem, VectorXd::Ones(2), std::vector<VectorXd>(3, VectorXd::Zero(1)));
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("trajopt: constraints(3) returned 2 values", 0), 0u)
+        << error.what();
   }
 }
 
@@ -237,8 +314,9 @@ TEST(Trajopt, ProjectedNewtonPolishFinishesFeasibility) {
     const VectorXd& x = polished.states[k];
     worst = std::max(worst, -proximity(s.car, examples::car_pose(x), s.bus, s.bus_pose).phi);
     if (k + 1 < s.knots) {
-      VectorXd next;
-      MatrixXd A, B;
+      examples::CarBusProblem::State next;
+      examples::CarBusProblem::StateMatrix A;
+      examples::CarBusProblem::ControlMatrix B;
       problem.dynamics(x, polished.controls[k], next, A, B);
       worst = std::max(worst, (next - polished.states[k + 1]).lpNorm<Eigen::Infinity>());
       worst = std::max(worst, (polished.controls[k].cwiseAbs() - s.control_limit).maxCoeff());
@@ -261,8 +339,9 @@ TEST(Trajopt, CarPassesTheBusAndReachesTheGoal) {
   VectorXd x = s.x0;
   double guess_min_phi = examples::car_bus_phi(s, x);
   for (const VectorXd& u : guess) {
-    VectorXd next;
-    MatrixXd A, B;
+    examples::CarBusProblem::State next;
+    examples::CarBusProblem::StateMatrix A;
+    examples::CarBusProblem::ControlMatrix B;
     problem.dynamics(x, u, next, A, B);
     x = next;
     guess_min_phi = std::min(guess_min_phi, examples::car_bus_phi(s, x));

@@ -18,6 +18,7 @@
 #include "arm_shelf/arm_shelf.hpp"
 #include "car_bus/car_bus.hpp"
 #include "diffpills/trajopt/car.hpp"
+#include "diffpills/trajopt/dynamic_problem.hpp"
 #include "diffpills/trajopt/quadrotor.hpp"
 #include "ipopt/ipopt_run.hpp"
 #include "quadrotor_window/quadrotor_window.hpp"
@@ -216,7 +217,9 @@ TEST(ProblemHessian, CarBus) {
       points.emplace_back(trial % 10 == 0 ? scenario.knots - 1 : trial % scenario.knots, z);
     }
     const bool phi = clearance == examples::Clearance::kProximity;
-    EXPECT_GE(check_problem(problem, points, rng, phi ? "car-bus, phi" : "car-bus, distance"), 150);
+    EXPECT_GE(check_problem(DynamicProblem<5, 2>(problem), points, rng,
+                            phi ? "car-bus, phi" : "car-bus, distance"),
+              150);
   }
 }
 
@@ -236,7 +239,8 @@ TEST(ProblemHessian, QuadrotorWindow) {
       points.emplace_back(trial % 10 == 0 ? scenario.knots - 1 : trial % scenario.knots, z);
     }
     const bool phi = clearance == examples::Clearance::kProximity;
-    EXPECT_GE(check_problem(problem, points, rng, phi ? "quadrotor, phi" : "quadrotor, distance"),
+    EXPECT_GE(check_problem(DynamicProblem<13, 4>(problem), points, rng,
+                            phi ? "quadrotor, phi" : "quadrotor, distance"),
               60);
   }
 }
@@ -256,19 +260,22 @@ TEST(ProblemHessian, ArmShelf) {
              : VectorXd(guess[static_cast<std::size_t>(k)] + normal_vector(rng, 7, 0.1));
     points.emplace_back(k, z);
   }
-  EXPECT_GE(check_problem(problem, points, rng, "arm-shelf"), 30);
+  EXPECT_GE(check_problem(DynamicProblem<7, 7>(problem), points, rng, "arm-shelf"), 30);
 }
 
-// Vectors of the wrong size are refused with the field named (the fixed-size models would read
-// past them).
+// Vectors of the wrong size are refused with the field named: by the fixed-size problems seen
+// through DynamicProblem (which would otherwise read past them), and mu by the problems.
 TEST(ProblemHessian, RefusesVectorsOfTheWrongSize) {
-  const examples::CarBusProblem car_bus{examples::CarBusScenario{}};
-  const examples::QuadrotorWindowProblem quadrotor{examples::QuadrotorWindowScenario{}};
-  const examples::ArmShelfProblem arm{examples::ArmShelfScenario{}};
+  const examples::CarBusProblem car_bus_problem{examples::CarBusScenario{}};
+  const examples::QuadrotorWindowProblem quadrotor_problem{examples::QuadrotorWindowScenario{}};
+  const examples::ArmShelfProblem arm_problem{examples::ArmShelfScenario{}};
+  const DynamicProblem<5, 2> car_bus(car_bus_problem);
+  const DynamicProblem<13, 4> quadrotor(quadrotor_problem);
+  const DynamicProblem<7, 7> arm(arm_problem);
   const std::array<std::pair<const Problem*, VectorXd>, 3> problems = {
-      std::pair{static_cast<const Problem*>(&car_bus), car_bus.scenario().x0},
-      std::pair{static_cast<const Problem*>(&quadrotor), quadrotor.scenario().x0},
-      std::pair{static_cast<const Problem*>(&arm), VectorXd(arm.scenario().start)}};
+      std::pair{static_cast<const Problem*>(&car_bus), car_bus_problem.scenario().x0},
+      std::pair{static_cast<const Problem*>(&quadrotor), quadrotor_problem.scenario().x0},
+      std::pair{static_cast<const Problem*>(&arm), VectorXd(arm_problem.scenario().start)}};
   for (const auto& entry : problems) {  // valid states: a zero quaternion is refused
     const Problem* problem = entry.first;
     const VectorXd& x = entry.second;

@@ -140,56 +140,56 @@ ArmShelfProblem::ArmShelfProblem(ArmShelfScenario scenario)
   }
 }
 
-void ArmShelfProblem::dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
-                               Eigen::VectorXd& next, Eigen::MatrixXd& A,
-                               Eigen::MatrixXd& B) const {
+void ArmShelfProblem::dynamics(const State& x, const Control& u, State& next, StateMatrix& A,
+                               ControlMatrix& B) const {
   next = x + scenario_.dt * u;
-  A = Eigen::MatrixXd::Identity(7, 7);
-  B = scenario_.dt * Eigen::MatrixXd::Identity(7, 7);
+  A.setIdentity();
+  B = scenario_.dt * ControlMatrix::Identity();
 }
 
-trajopt::CostExpansion ArmShelfProblem::stage_cost(int, const Eigen::VectorXd&,
-                                                   const Eigen::VectorXd& u) const {
-  trajopt::CostExpansion cost;
+ArmShelfProblem::Cost ArmShelfProblem::stage_cost(int, const State&, const Control& u) const {
+  Cost cost;
   cost.value = 0.5 * scenario_.dt * u.squaredNorm();
-  cost.x = Eigen::VectorXd::Zero(7);
+  cost.x.setZero();
   cost.u = scenario_.dt * u;
-  cost.xx = Eigen::MatrixXd::Zero(7, 7);
-  cost.uu = scenario_.dt * Eigen::MatrixXd::Identity(7, 7);
-  cost.ux = Eigen::MatrixXd::Zero(7, 7);
+  cost.xx.setZero();
+  cost.uu = scenario_.dt * Eigen::Matrix<double, 7, 7>::Identity();
+  cost.ux.setZero();
   return cost;
 }
 
-trajopt::CostExpansion ArmShelfProblem::terminal_cost(const Eigen::VectorXd&) const {
-  trajopt::CostExpansion cost;
-  cost.x = Eigen::VectorXd::Zero(7);
-  cost.xx = Eigen::MatrixXd::Zero(7, 7);
+ArmShelfProblem::Cost ArmShelfProblem::terminal_cost(const State&) const {
+  Cost cost;
+  cost.x.setZero();
+  cost.u.setZero();
+  cost.xx.setZero();
+  cost.uu.setZero();
+  cost.ux.setZero();
   return cost;
 }
 
-trajopt::KnotConstraints ArmShelfProblem::constraints(int k, const Eigen::VectorXd& x,
-                                                      const Eigen::VectorXd& u) const {
+ArmShelfProblem::Constraints ArmShelfProblem::constraints(int k, const State& x,
+                                                          const Control& u) const {
   return evaluate(k, x, u, true);
 }
 
-trajopt::KnotConstraints ArmShelfProblem::constraint_values(int k, const Eigen::VectorXd& x,
-                                                            const Eigen::VectorXd& u) const {
+ArmShelfProblem::Constraints ArmShelfProblem::constraint_values(int k, const State& x,
+                                                                const Control& u) const {
   return evaluate(k, x, u, false);
 }
 
-trajopt::KnotConstraints ArmShelfProblem::evaluate(int k, const Eigen::VectorXd& x,
-                                                   const Eigen::VectorXd& u,
-                                                   bool derivatives) const {
+ArmShelfProblem::Constraints ArmShelfProblem::evaluate(int k, const State& x, const Control& u,
+                                                       bool derivatives) const {
   const bool last = k == knots() - 1;
   const int goals = goal_rows(last), first_collision = collision_start(last);
   const int rows =
       first_collision + (last ? 1 : scenario_.substeps) * static_cast<int>(pairs_.size());
-  trajopt::KnotConstraints out;
+  Constraints out;
   out.equalities = goals;
   out.value.resize(rows);
   if (derivatives) {
-    out.dx = Eigen::MatrixXd::Zero(rows, 7);
-    out.du = Eigen::MatrixXd::Zero(rows, last ? 0 : 7);
+    out.dx.setZero(rows, 7);
+    out.du.setZero(rows, 7);
   }
   const auto& limits = scenario_.arm.joint_limits;
   if (last) {
@@ -219,7 +219,7 @@ trajopt::KnotConstraints ArmShelfProblem::evaluate(int k, const Eigen::VectorXd&
   const int substeps = last ? 1 : scenario_.substeps;
   for (int step = 0; step < substeps; ++step) {
     const double fraction = static_cast<double>(step) / scenario_.substeps;
-    const Eigen::VectorXd q = last ? x : Eigen::VectorXd(x + fraction * scenario_.dt * u);
+    const State q = last ? x : State(x + fraction * scenario_.dt * u);
     trajopt::ChainFrames frames;
     const std::vector<Pose> poses = arm_shelf_poses(scenario_, q, derivatives ? &frames : nullptr);
     const Eigen::Index first_row = first_collision + step * pair_count;
@@ -248,12 +248,8 @@ trajopt::KnotConstraints ArmShelfProblem::evaluate(int k, const Eigen::VectorXd&
   return out;
 }
 
-Eigen::MatrixXd ArmShelfProblem::dynamics_hessian(const Eigen::VectorXd& x,
-                                                  const Eigen::VectorXd& u,
-                                                  const Eigen::VectorXd& lambda) const {
-  trajopt::require_size(x, 7, "x");
-  trajopt::require_size(u, 7, "u");
-  trajopt::require_size(lambda, 7, "lambda");
+Eigen::MatrixXd ArmShelfProblem::dynamics_hessian(const State&, const Control&,
+                                                  const State&) const {
   return Eigen::MatrixXd::Zero(14, 14);  // x + dt u is linear
 }
 
@@ -299,19 +295,17 @@ Eigen::MatrixXd ArmShelfProblem::contact_hessian(const Contact& contact,
 // min(distance(q), margin) with q = x + c u, c = (s / S) dt, adds -mu times the distance's
 // Hessian in q, [I; c I]' H_q [I, c I] in [x; u], where the contact is within the margin (beyond
 // it the row is constant).
-Eigen::MatrixXd ArmShelfProblem::constraint_hessian(int k, const Eigen::VectorXd& x,
-                                                    const Eigen::VectorXd& u,
+Eigen::MatrixXd ArmShelfProblem::constraint_hessian(int k, const State& x, const Control& u,
                                                     const Eigen::VectorXd& mu) const {
   const bool last = k == knots() - 1;
   const auto pair_count = static_cast<Eigen::Index>(pairs_.size());
   const int substeps = last ? 1 : scenario_.substeps;
-  trajopt::require_size(x, 7, "x");
-  trajopt::require_size(u, last ? 0 : 7, "u");
   trajopt::require_size(mu, collision_start(last) + substeps * pair_count, "mu");
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(7 + u.size(), 7 + u.size());
+  const int size = last ? 7 : 14;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(size, size);
   for (int step = 0; step < substeps; ++step) {
     const double c = static_cast<double>(step) / scenario_.substeps * scenario_.dt;
-    const Eigen::VectorXd q = last ? x : Eigen::VectorXd(x + c * u);
+    const State q = last ? x : State(x + c * u);
     trajopt::ChainFrames frames;
     const std::vector<Pose> poses = arm_shelf_poses(scenario_, q, &frames);
     for (const Contact& contact : scene_.contacts(poses, scenario_.query_margin)) {

@@ -84,32 +84,29 @@ Scene arm_shelf_scene(const ArmShelfScenario& scenario);
 std::vector<Pose> arm_shelf_poses(const ArmShelfScenario& scenario, const Eigen::VectorXd& q,
                                   trajopt::ChainFrames* frames = nullptr);
 
-class ArmShelfProblem : public trajopt::Problem {
+class ArmShelfProblem : public trajopt::ProblemOf<7, 7> {
  public:
   explicit ArmShelfProblem(ArmShelfScenario scenario);
 
   int state_size() const override { return 7; }
   int control_size() const override { return 7; }
   int knots() const override { return scenario_.knots; }
-  void dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& next,
-                Eigen::MatrixXd& A, Eigen::MatrixXd& B) const override;
-  trajopt::CostExpansion stage_cost(int k, const Eigen::VectorXd& x,
-                                    const Eigen::VectorXd& u) const override;
-  trajopt::CostExpansion terminal_cost(const Eigen::VectorXd& x) const override;
+  void dynamics(const State& x, const Control& u, State& next, StateMatrix& A,
+                ControlMatrix& B) const override;
+  Cost stage_cost(int k, const State& x, const Control& u) const override;
+  Cost terminal_cost(const State& x) const override;
   // Rows: at the last knot the goal (7 equalities) first; then the joint limits (14), the
   // velocity limits (14, not at the last knot) and, for each substep (one at the last knot), one
   // row per checked shape pair, clearance - min(signed distance, query_margin) <= 0.
-  trajopt::KnotConstraints constraints(int k, const Eigen::VectorXd& x,
-                                       const Eigen::VectorXd& u) const override;
-  trajopt::KnotConstraints constraint_values(int k, const Eigen::VectorXd& x,
-                                             const Eigen::VectorXd& u) const override;
+  Constraints constraints(int k, const State& x, const Control& u) const override;
+  Constraints constraint_values(int k, const State& x, const Control& u) const override;
   // Exact second derivatives: the dynamics are linear and the cost quadratic; each collision row's
   // Hessian chains signed_distance_hessian through the shapes' poses and the arm's forward
   // kinematics (serial_chain.hpp's attached_pose_derivatives).
   bool has_second_derivatives() const override { return true; }
-  Eigen::MatrixXd dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
-                                   const Eigen::VectorXd& lambda) const override;
-  Eigen::MatrixXd constraint_hessian(int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+  Eigen::MatrixXd dynamics_hessian(const State& x, const Control& u,
+                                   const State& lambda) const override;
+  Eigen::MatrixXd constraint_hessian(int k, const State& x, const Control& u,
                                      const Eigen::VectorXd& mu) const override;
 
   const ArmShelfScenario& scenario() const { return scenario_; }
@@ -130,8 +127,7 @@ class ArmShelfProblem : public trajopt::Problem {
   std::vector<Eigen::VectorXd> retreat_controls() const;
 
  private:
-  trajopt::KnotConstraints evaluate(int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
-                                    bool derivatives) const;
+  Constraints evaluate(int k, const State& x, const Control& u, bool derivatives) const;
   // The Hessian of a contact's signed distance with respect to the joint angles (7 x 7).
   Eigen::MatrixXd contact_hessian(const Contact& contact, const trajopt::ChainFrames& frames) const;
 

@@ -4,7 +4,7 @@
 
 namespace diffpills::examples {
 
-Pose car_pose(const Eigen::VectorXd& x) {
+Pose car_pose(const Eigen::Ref<const Eigen::VectorXd>& x) {
   return Pose(Eigen::Vector3d(x(0), x(1), 0.0),
               Eigen::Vector4d(std::cos(0.5 * x(2)), 0.0, 0.0, std::sin(0.5 * x(2))));
 }
@@ -13,15 +13,41 @@ namespace {
 
 // d/dx of a measure with pose gradient g (the car's 7 entries first): [dg/dr_x, dg/dr_y,
 // dg/dq . dq/dtheta, 0, 0] with dq/dtheta = [-sin(theta/2), 0, 0, cos(theta/2)] / 2.
-void state_gradient(const Eigen::Matrix<double, 14, 1>& g, const Eigen::VectorXd& x,
-                    Eigen::VectorXd* gradient) {
-  if (gradient == nullptr) return;
+trajopt::Car::State state_gradient(const Eigen::Matrix<double, 14, 1>& g,
+                                   const Eigen::Ref<const Eigen::VectorXd>& x) {
   const Eigen::Vector4d dq_dtheta(-0.5 * std::sin(0.5 * x(2)), 0.0, 0.0,
                                   0.5 * std::cos(0.5 * x(2)));
-  gradient->setZero(5);
-  (*gradient)(0) = g(0);
-  (*gradient)(1) = g(1);
-  (*gradient)(2) = g.segment<4>(3).dot(dq_dtheta);
+  trajopt::Car::State gradient = trajopt::Car::State::Zero();
+  gradient(0) = g(0);
+  gradient(1) = g(1);
+  gradient(2) = g.segment<4>(3).dot(dq_dtheta);
+  return gradient;
+}
+
+// The scenario's measure (phi when `phi` is set, else its clearance) with its state gradient when
+// asked for: the problem's rows and the public helpers below.
+double measure(const CarBusScenario& scenario, bool phi, const Eigen::Ref<const Eigen::VectorXd>& x,
+               trajopt::Car::State* gradient) {
+  if (phi || scenario.clearance == Clearance::kProximity) {
+    const Proximity p = proximity(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
+    if (gradient != nullptr) *gradient = state_gradient(p.gradient, x);
+    return p.phi;
+  }
+  const SignedDistance s =
+      signed_distance(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
+  if (gradient != nullptr) *gradient = state_gradient(s.gradient, x);
+  return s.distance;
+}
+
+double measure(const CarBusScenario& scenario, bool phi, const Eigen::Ref<const Eigen::VectorXd>& x,
+               Eigen::VectorXd* gradient) {
+  if (gradient == nullptr) {
+    return measure(scenario, phi, x, static_cast<trajopt::Car::State*>(nullptr));
+  }
+  trajopt::Car::State fixed;
+  const double value = measure(scenario, phi, x, &fixed);
+  *gradient = fixed;
+  return value;
 }
 
 // The chain rule once more: with J = d pose / dx as above (rows r_x, r_y and q's four) and
@@ -29,7 +55,7 @@ void state_gradient(const Eigen::Matrix<double, 14, 1>& g, const Eigen::VectorXd
 //   J' H J + (g_q . (-q / 4)) e_theta e_theta'.
 Eigen::Matrix<double, 5, 5> state_hessian(const Eigen::Matrix<double, 14, 14>& H,
                                           const Eigen::Matrix<double, 14, 1>& g,
-                                          const Eigen::VectorXd& x) {
+                                          const Eigen::Ref<const Eigen::VectorXd>& x) {
   const Eigen::Vector4d q(std::cos(0.5 * x(2)), 0.0, 0.0, std::sin(0.5 * x(2)));
   Eigen::Matrix<double, 7, 5> J = Eigen::Matrix<double, 7, 5>::Zero();
   J(0, 0) = 1.0;
@@ -43,134 +69,114 @@ Eigen::Matrix<double, 5, 5> state_hessian(const Eigen::Matrix<double, 14, 14>& H
 }  // namespace
 
 Eigen::Matrix<double, 5, 5> car_bus_phi_hessian(const CarBusScenario& scenario,
-                                                const Eigen::VectorXd& x) {
+                                                const Eigen::Ref<const Eigen::VectorXd>& x) {
   const ProximityHessian p =
       proximity_hessian(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
   return state_hessian(p.hessian, p.gradient, x);
 }
 
 Eigen::Matrix<double, 5, 5> car_bus_clearance_hessian(const CarBusScenario& scenario,
-                                                      const Eigen::VectorXd& x) {
+                                                      const Eigen::Ref<const Eigen::VectorXd>& x) {
   if (scenario.clearance == Clearance::kProximity) return car_bus_phi_hessian(scenario, x);
   const SignedDistanceHessian s =
       signed_distance_hessian(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
   return state_hessian(s.hessian, s.gradient, x);
 }
 
-double car_bus_phi(const CarBusScenario& scenario, const Eigen::VectorXd& x,
+double car_bus_phi(const CarBusScenario& scenario, const Eigen::Ref<const Eigen::VectorXd>& x,
                    Eigen::VectorXd* gradient) {
-  const Proximity p = proximity(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
-  state_gradient(p.gradient, x, gradient);
-  return p.phi;
+  return measure(scenario, true, x, gradient);
 }
 
-double car_bus_clearance(const CarBusScenario& scenario, const Eigen::VectorXd& x,
+double car_bus_clearance(const CarBusScenario& scenario, const Eigen::Ref<const Eigen::VectorXd>& x,
                          Eigen::VectorXd* gradient) {
-  if (scenario.clearance == Clearance::kProximity) return car_bus_phi(scenario, x, gradient);
-  const SignedDistance s =
-      signed_distance(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
-  state_gradient(s.gradient, x, gradient);
-  return s.distance;
+  return measure(scenario, false, x, gradient);
 }
 
 CarBusProblem::CarBusProblem(CarBusScenario scenario) : scenario_(std::move(scenario)) {
-  Q_ = 0.01 * Eigen::MatrixXd::Identity(5, 5);
-  R_ = 0.1 * Eigen::MatrixXd::Identity(2, 2);
-  Qf_ = Eigen::VectorXd((Eigen::VectorXd(5) << 0.0, 0.0, 0.0, 10.0, 10.0).finished()).asDiagonal();
+  trajopt::require_size(scenario_.goal, 5, "scenario.goal");
+  goal_ = scenario_.goal;
+  Q_ = 0.01 * StateMatrix::Identity();
+  R_ = 0.1 * Eigen::Matrix2d::Identity();
+  Qf_ = State(0.0, 0.0, 0.0, 10.0, 10.0).asDiagonal();
 }
 
-void CarBusProblem::dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
-                             Eigen::VectorXd& next, Eigen::MatrixXd& A, Eigen::MatrixXd& B) const {
-  trajopt::Car::State fixed_next;
-  Eigen::Matrix<double, 5, 5> fixed_A;
-  Eigen::Matrix<double, 5, 2> fixed_B;
-  scenario_.car_model.step(scenario_.dt, x, u, fixed_next, fixed_A, fixed_B);
-  next = fixed_next;
-  A = fixed_A;
-  B = fixed_B;
+void CarBusProblem::dynamics(const State& x, const Control& u, State& next, StateMatrix& A,
+                             ControlMatrix& B) const {
+  scenario_.car_model.step(scenario_.dt, x, u, next, A, B);
 }
 
-Eigen::MatrixXd CarBusProblem::dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
-                                                const Eigen::VectorXd& lambda) const {
-  trajopt::require_size(x, 5, "x");
-  trajopt::require_size(u, 2, "u");
-  trajopt::require_size(lambda, 5, "lambda");
+Eigen::MatrixXd CarBusProblem::dynamics_hessian(const State& x, const Control& u,
+                                                const State& lambda) const {
   return scenario_.car_model.step_hessian(scenario_.dt, x, u, lambda);
 }
 
 // Only the clearance row (after the last knot's three equalities) is nonlinear; at the last knot
 // the Hessian is in x alone.
-Eigen::MatrixXd CarBusProblem::constraint_hessian(int k, const Eigen::VectorXd& x,
-                                                  const Eigen::VectorXd& u,
+Eigen::MatrixXd CarBusProblem::constraint_hessian(int k, const State& x, const Control&,
                                                   const Eigen::VectorXd& mu) const {
   const bool last = k == scenario_.knots - 1;
-  trajopt::require_size(x, 5, "x");
-  trajopt::require_size(u, last ? 0 : 2, "u");
   trajopt::require_size(mu, last ? 4 : 5, "mu");  // evaluate_constraints' rows
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(5 + u.size(), 5 + u.size());
+  const int size = last ? 5 : 7;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(size, size);
   H.topLeftCorner<5, 5>() = -mu(last ? 3 : 0) * car_bus_clearance_hessian(scenario_, x);
   return H;
 }
 
-trajopt::CostExpansion CarBusProblem::stage_cost(int, const Eigen::VectorXd& x,
-                                                 const Eigen::VectorXd& u) const {
-  const Eigen::VectorXd e = x - scenario_.goal;
-  return {0.5 * e.dot(Q_ * e) + 0.5 * u.dot(R_ * u),
-          Q_ * e,
-          R_ * u,
-          Q_,
-          R_,
-          Eigen::MatrixXd::Zero(2, 5)};
+CarBusProblem::Cost CarBusProblem::stage_cost(int, const State& x, const Control& u) const {
+  const State e = x - goal_;
+  return {0.5 * e.dot(Q_ * e) + 0.5 * u.dot(R_ * u), Q_ * e, R_ * u, Q_, R_,
+          Eigen::Matrix<double, 2, 5>::Zero()};
 }
 
-trajopt::CostExpansion CarBusProblem::terminal_cost(const Eigen::VectorXd& x) const {
-  const Eigen::VectorXd e = x - scenario_.goal;
-  return {0.5 * e.dot(Qf_ * e), Qf_ * e,          Eigen::VectorXd(), Qf_,
-          Eigen::MatrixXd(),    Eigen::MatrixXd()};
+CarBusProblem::Cost CarBusProblem::terminal_cost(const State& x) const {
+  const State e = x - goal_;
+  return {0.5 * e.dot(Qf_ * e),    Qf_ * e,
+          Control::Zero(),         Qf_,
+          Eigen::Matrix2d::Zero(), Eigen::Matrix<double, 2, 5>::Zero()};
 }
 
-double CarBusProblem::stage_cost_value(int, const Eigen::VectorXd& x,
-                                       const Eigen::VectorXd& u) const {
-  const Eigen::VectorXd e = x - scenario_.goal;
+double CarBusProblem::stage_cost_value(int, const State& x, const Control& u) const {
+  const State e = x - goal_;
   return 0.5 * e.dot(Q_ * e) + 0.5 * u.dot(R_ * u);
 }
 
-double CarBusProblem::terminal_cost_value(const Eigen::VectorXd& x) const {
-  const Eigen::VectorXd e = x - scenario_.goal;
+double CarBusProblem::terminal_cost_value(const State& x) const {
+  const State e = x - goal_;
   return 0.5 * e.dot(Qf_ * e);
 }
 
-trajopt::KnotConstraints CarBusProblem::constraints(int k, const Eigen::VectorXd& x,
-                                                    const Eigen::VectorXd& u) const {
+CarBusProblem::Constraints CarBusProblem::constraints(int k, const State& x,
+                                                      const Control& u) const {
   return evaluate_constraints(k, x, u, true);
 }
 
-trajopt::KnotConstraints CarBusProblem::constraint_values(int k, const Eigen::VectorXd& x,
-                                                          const Eigen::VectorXd& u) const {
+CarBusProblem::Constraints CarBusProblem::constraint_values(int k, const State& x,
+                                                            const Control& u) const {
   return evaluate_constraints(k, x, u, false);
 }
 
 // Rows: [equalities: px, py, theta - goal (last knot only)], -clearance, then u - limit,
 // -u - limit.
-trajopt::KnotConstraints CarBusProblem::evaluate_constraints(int k, const Eigen::VectorXd& x,
-                                                             const Eigen::VectorXd& u,
-                                                             bool derivatives) const {
+CarBusProblem::Constraints CarBusProblem::evaluate_constraints(int k, const State& x,
+                                                               const Control& u,
+                                                               bool derivatives) const {
   const bool last = k == scenario_.knots - 1;
   const int equalities = last ? 3 : 0;
   const int rows = equalities + 1 + (last ? 0 : 4);
-  trajopt::KnotConstraints c;
+  Constraints c;
   c.equalities = equalities;
   c.value = Eigen::VectorXd::Zero(rows);
   if (derivatives) {
-    c.dx = Eigen::MatrixXd::Zero(rows, 5);
-    c.du = Eigen::MatrixXd::Zero(rows, last ? 0 : 2);
+    c.dx.setZero(rows, 5);
+    c.du.setZero(rows, 2);
   }
   if (last) {
-    c.value.head<3>() = x.head<3>() - scenario_.goal.head<3>();
+    c.value.head<3>() = x.head<3>() - goal_.head<3>();
     if (derivatives) c.dx.topLeftCorner<3, 3>().setIdentity();
   }
-  Eigen::VectorXd gradient;
-  c.value(equalities) = -car_bus_clearance(scenario_, x, derivatives ? &gradient : nullptr);
+  State gradient;
+  c.value(equalities) = -measure(scenario_, false, x, derivatives ? &gradient : nullptr);
   if (derivatives) c.dx.row(equalities) = -gradient.transpose();
   if (!last) {
     for (int i = 0; i < 2; ++i) {

@@ -34,6 +34,7 @@ class CarBusNlp : public Ipopt::TNLP {
   CarBusNlp(const CarBusProblem& problem, std::vector<Eigen::VectorXd> guess_states,
             std::vector<Eigen::VectorXd> guess_controls)
       : problem_(problem),
+        view_(problem),
         layout_{problem.knots()},
         guess_states_(std::move(guess_states)),
         guess_controls_(std::move(guess_controls)),
@@ -100,7 +101,7 @@ class CarBusNlp : public Ipopt::TNLP {
     for (int k = 0; k + 1 < layout_.knots; ++k) {
       Eigen::VectorXd next;
       Eigen::MatrixXd A, B;
-      problem_.dynamics(state(z, k), control(z, k), next, A, B);
+      view_.dynamics(state(z, k), control(z, k), next, A, B);
       Eigen::Map<Eigen::VectorXd>(g + layout_.state(k), kState) = state(z, k + 1) - next;
     }
     for (int k = 0; k < layout_.knots; ++k) {
@@ -115,7 +116,7 @@ class CarBusNlp : public Ipopt::TNLP {
     for (int k = 0; k + 1 < layout_.knots; ++k) {
       Eigen::VectorXd next;
       Eigen::MatrixXd A, B;
-      if (values != nullptr) problem_.dynamics(state(z, k), control(z, k), next, A, B);
+      if (values != nullptr) view_.dynamics(state(z, k), control(z, k), next, A, B);
       for (int i = 0; i < kState; ++i) {
         const std::ptrdiff_t row = layout_.state(k) + i;
         add(rows, cols, values, entry, row, layout_.state(k + 1) + i, 1.0);
@@ -142,7 +143,7 @@ class CarBusNlp : public Ipopt::TNLP {
   bool eval_h(Index, const Number* z, bool, Number obj_factor, Index, const Number* lambda, bool,
               Index, Index* rows, Index* cols, Number* values) override {
     return hessian_.eval_h(
-        problem_, z, obj_factor, lambda,
+        view_, z, obj_factor, lambda,
         [&](int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u) -> Eigen::MatrixXd {
           Eigen::MatrixXd H = Eigen::MatrixXd::Zero(kState + u.size(), kState + u.size());
           H.topLeftCorner<kState, kState>() =
@@ -180,14 +181,14 @@ class CarBusNlp : public Ipopt::TNLP {
     double total = 0.0;
     if (gradient != nullptr) gradient->setZero();
     for (int k = 0; k + 1 < layout_.knots; ++k) {
-      const trajopt::CostExpansion l = problem_.stage_cost(k, state(z, k), control(z, k));
+      const trajopt::CostExpansion l = view_.stage_cost(k, state(z, k), control(z, k));
       total += l.value;
       if (gradient != nullptr) {
         gradient->segment(layout_.state(k), kState) += l.x;
         gradient->segment(layout_.control(k), kControl) += l.u;
       }
     }
-    const trajopt::CostExpansion terminal = problem_.terminal_cost(state(z, layout_.knots - 1));
+    const trajopt::CostExpansion terminal = view_.terminal_cost(state(z, layout_.knots - 1));
     total += terminal.value;
     if (gradient != nullptr)
       gradient->segment(layout_.state(layout_.knots - 1), kState) += terminal.x;
@@ -206,6 +207,7 @@ class CarBusNlp : public Ipopt::TNLP {
   }
 
   const CarBusProblem& problem_;
+  const trajopt::DynamicProblem<5, 2> view_;  // the problem in the run-time sizes of this NLP
   Layout layout_;
   std::vector<Eigen::VectorXd> guess_states_, guess_controls_;
   KnotHessian hessian_;

@@ -54,8 +54,9 @@ CarBusRun solve_car_bus(const examples::CarBusProblem& problem,
   Eigen::VectorXd x = s.x0;
   run.guess_min_phi = examples::car_bus_phi(s, x);
   for (const Eigen::VectorXd& u : guess) {
-    Eigen::VectorXd next;
-    Eigen::MatrixXd A, B;
+    examples::CarBusProblem::State next;
+    examples::CarBusProblem::StateMatrix A;
+    examples::CarBusProblem::ControlMatrix B;
     problem.dynamics(x, u, next, A, B);
     x = next;
     run.guess_min_phi = std::min(run.guess_min_phi, examples::car_bus_phi(s, x));

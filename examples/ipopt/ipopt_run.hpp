@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "diffpills/trajopt/dynamic_problem.hpp"
 #include "diffpills/trajopt/problem.hpp"
 
 namespace diffpills::examples {
@@ -31,5 +32,11 @@ struct IpoptRun {
 // rollout, as ALTRO does.
 std::vector<Eigen::VectorXd> rollout(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
                                      const std::vector<Eigen::VectorXd>& controls);
+template <int Nx, int Nu>
+std::vector<Eigen::VectorXd> rollout(const trajopt::ProblemOf<Nx, Nu>& problem,
+                                     const Eigen::VectorXd& x0,
+                                     const std::vector<Eigen::VectorXd>& controls) {
+  return rollout(trajopt::DynamicProblem<Nx, Nu>(problem), x0, controls);
+}
 
 }  // namespace diffpills::examples

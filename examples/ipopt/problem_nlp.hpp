@@ -8,12 +8,13 @@
 // Hessian approximation or the exact Hessian of the Lagrangian from the problem's second
 // derivatives (block diagonal by knot: knot_hessian.hpp), started from the rollout of the initial
 // controls, as ALTRO is. kExact needs problem.has_second_derivatives() (else
-// std::invalid_argument).
+// std::invalid_argument). A fixed-size problem is seen through trajopt::DynamicProblem.
 #pragma once
 
 #include <Eigen/Core>
 #include <vector>
 
+#include "diffpills/trajopt/dynamic_problem.hpp"
 #include "diffpills/trajopt/problem.hpp"
 #include "ipopt_run.hpp"
 
@@ -22,5 +23,14 @@ namespace diffpills::examples {
 IpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
                                   const std::vector<Eigen::VectorXd>& initial_controls,
                                   IpoptHessian hessian = IpoptHessian::kLimitedMemory);
+
+template <int Nx, int Nu>
+IpoptRun solve_problem_with_ipopt(const trajopt::ProblemOf<Nx, Nu>& problem,
+                                  const Eigen::VectorXd& x0,
+                                  const std::vector<Eigen::VectorXd>& initial_controls,
+                                  IpoptHessian hessian = IpoptHessian::kLimitedMemory) {
+  return solve_problem_with_ipopt(trajopt::DynamicProblem<Nx, Nu>(problem), x0, initial_controls,
+                                  hessian);
+}
 
 }  // namespace diffpills::examples

@@ -80,7 +80,9 @@ void QuadrotorWindowScenario::build() {
   poles = {pole(1.5, 0.2, 3.0, 0.1), pole(4.5, -0.2, 3.0, 0.1)};
 }
 
-Pose quadrotor_pose(const Eigen::VectorXd& x) { return Pose(x.head<3>(), x.segment<4>(3)); }
+Pose quadrotor_pose(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  return Pose(x.head<3>(), x.segment<4>(3));
+}
 
 double quadrotor_min_phi(const QuadrotorWindowScenario& scenario, const Eigen::VectorXd& x) {
   const Pose pose = quadrotor_pose(x);
@@ -96,54 +98,47 @@ double quadrotor_min_phi(const QuadrotorWindowScenario& scenario, const Eigen::V
 
 QuadrotorWindowProblem::QuadrotorWindowProblem(QuadrotorWindowScenario scenario)
     : scenario_(std::move(scenario)) {
-  hover_ = Eigen::Vector4d::Constant(scenario_.model.hover_thrust());
-  Q_ = 0.01 * Eigen::MatrixXd::Identity(13, 13);
-  Eigen::VectorXd qf = Eigen::VectorXd::Constant(13, 10.0);
+  trajopt::require_size(scenario_.goal, 13, "scenario.goal");
+  goal_ = scenario_.goal;
+  hover_ = Control::Constant(scenario_.model.hover_thrust());
+  Q_ = 0.01 * StateMatrix::Identity();
+  State qf = State::Constant(10.0);
   qf.tail<3>().setConstant(1.0);  // angular velocity weighs less at the end
   Qf_ = qf.asDiagonal();
-  R_ = 0.1 * Eigen::MatrixXd::Identity(4, 4);
+  R_ = 0.1 * Eigen::Matrix4d::Identity();
 }
 
 int QuadrotorWindowProblem::obstacle_count() const {
   return static_cast<int>(scenario_.wall.size() + scenario_.poles.size());
 }
 
-void QuadrotorWindowProblem::dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
-                                      Eigen::VectorXd& next, Eigen::MatrixXd& A,
-                                      Eigen::MatrixXd& B) const {
-  trajopt::Quadrotor::State fixed_next;
-  trajopt::Quadrotor::StateMatrix fixed_A;
-  trajopt::Quadrotor::ControlMatrix fixed_B;
-  scenario_.model.step(scenario_.dt, x, u, fixed_next, fixed_A, fixed_B);
-  next = fixed_next;
-  A = fixed_A;
-  B = fixed_B;
+void QuadrotorWindowProblem::dynamics(const State& x, const Control& u, State& next, StateMatrix& A,
+                                      ControlMatrix& B) const {
+  scenario_.model.step(scenario_.dt, x, u, next, A, B);
 }
 
-trajopt::CostExpansion QuadrotorWindowProblem::stage_cost(int, const Eigen::VectorXd& x,
-                                                          const Eigen::VectorXd& u) const {
-  const Eigen::VectorXd e = x - scenario_.goal, du = u - hover_;
-  return {0.5 * e.dot(Q_ * e) + 0.5 * du.dot(R_ * du),
-          Q_ * e,
-          R_ * du,
-          Q_,
-          R_,
-          Eigen::MatrixXd::Zero(4, 13)};
+QuadrotorWindowProblem::Cost QuadrotorWindowProblem::stage_cost(int, const State& x,
+                                                                const Control& u) const {
+  const State e = x - goal_;
+  const Control du = u - hover_;
+  return {0.5 * e.dot(Q_ * e) + 0.5 * du.dot(R_ * du), Q_ * e, R_ * du, Q_, R_,
+          Eigen::Matrix<double, 4, 13>::Zero()};
 }
 
-trajopt::CostExpansion QuadrotorWindowProblem::terminal_cost(const Eigen::VectorXd& x) const {
-  const Eigen::VectorXd e = x - scenario_.goal;
-  return {0.5 * e.dot(Qf_ * e), Qf_ * e,          Eigen::VectorXd(), Qf_,
-          Eigen::MatrixXd(),    Eigen::MatrixXd()};
+QuadrotorWindowProblem::Cost QuadrotorWindowProblem::terminal_cost(const State& x) const {
+  const State e = x - goal_;
+  return {0.5 * e.dot(Qf_ * e),    Qf_ * e,
+          Control::Zero(),         Qf_,
+          Eigen::Matrix4d::Zero(), Eigen::Matrix<double, 4, 13>::Zero()};
 }
 
-trajopt::KnotConstraints QuadrotorWindowProblem::constraints(int k, const Eigen::VectorXd& x,
-                                                             const Eigen::VectorXd& u) const {
+QuadrotorWindowProblem::Constraints QuadrotorWindowProblem::constraints(int k, const State& x,
+                                                                        const Control& u) const {
   return evaluate_constraints(k, x, u, true);
 }
 
-trajopt::KnotConstraints QuadrotorWindowProblem::constraint_values(int k, const Eigen::VectorXd& x,
-                                                                   const Eigen::VectorXd& u) const {
+QuadrotorWindowProblem::Constraints QuadrotorWindowProblem::constraint_values(
+    int k, const State& x, const Control& u) const {
   return evaluate_constraints(k, x, u, false);
 }
 
@@ -151,23 +146,21 @@ trajopt::KnotConstraints QuadrotorWindowProblem::constraint_values(int k, const 
 // then poles), then u - thrust_max and -u. d(-phi)/dx takes the measure's gradient's first seven
 // entries (d/dr, d/dq of the body, the first shape) as they are: q is the state's own quaternion,
 // and the library's gradient already includes the normalization of q.
-trajopt::KnotConstraints QuadrotorWindowProblem::evaluate_constraints(int k,
-                                                                      const Eigen::VectorXd& x,
-                                                                      const Eigen::VectorXd& u,
-                                                                      bool derivatives) const {
+QuadrotorWindowProblem::Constraints QuadrotorWindowProblem::evaluate_constraints(
+    int k, const State& x, const Control& u, bool derivatives) const {
   const bool last = k == scenario_.knots - 1;
   const int equalities = last ? 3 : 0;
   const int obstacles = obstacle_count();
   const int rows = equalities + obstacles + (last ? 0 : 8);
-  trajopt::KnotConstraints c;
+  Constraints c;
   c.equalities = equalities;
   c.value = Eigen::VectorXd::Zero(rows);
   if (derivatives) {
-    c.dx = Eigen::MatrixXd::Zero(rows, 13);
-    c.du = Eigen::MatrixXd::Zero(rows, last ? 0 : 4);
+    c.dx.setZero(rows, 13);
+    c.du.setZero(rows, 4);
   }
   if (last) {
-    c.value.head<3>() = x.head<3>() - scenario_.goal.head<3>();
+    c.value.head<3>() = x.head<3>() - goal_.head<3>();
     if (derivatives) c.dx.topLeftCorner<3, 3>().setIdentity();
   }
   const Pose pose = quadrotor_pose(x);
@@ -200,25 +193,19 @@ trajopt::KnotConstraints QuadrotorWindowProblem::evaluate_constraints(int k,
   return c;
 }
 
-Eigen::MatrixXd QuadrotorWindowProblem::dynamics_hessian(const Eigen::VectorXd& x,
-                                                         const Eigen::VectorXd& u,
-                                                         const Eigen::VectorXd& lambda) const {
-  trajopt::require_size(x, 13, "x");
-  trajopt::require_size(u, 4, "u");
-  trajopt::require_size(lambda, 13, "lambda");
+Eigen::MatrixXd QuadrotorWindowProblem::dynamics_hessian(const State& x, const Control& u,
+                                                         const State& lambda) const {
   return scenario_.model.step_hessian(scenario_.dt, x, u, lambda);
 }
 
 // The obstacle rows are the only nonlinear ones: each adds -mu times its measure's Hessian with
 // respect to the body's pose, which is the state's first seven entries as they are.
-Eigen::MatrixXd QuadrotorWindowProblem::constraint_hessian(int k, const Eigen::VectorXd& x,
-                                                           const Eigen::VectorXd& u,
+Eigen::MatrixXd QuadrotorWindowProblem::constraint_hessian(int k, const State& x, const Control&,
                                                            const Eigen::VectorXd& mu) const {
   const bool last = k == scenario_.knots - 1;
-  trajopt::require_size(x, 13, "x");
-  trajopt::require_size(u, last ? 0 : 4, "u");
   trajopt::require_size(mu, (last ? 3 : 0) + obstacle_count() + (last ? 0 : 8), "mu");
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(13 + u.size(), 13 + u.size());
+  const int size = last ? 13 : 17;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(size, size);
   const Pose pose = quadrotor_pose(x);
   int row = last ? 3 : 0;
   const auto add = [&](const auto& obstacle) {
@@ -236,7 +223,7 @@ Eigen::MatrixXd QuadrotorWindowProblem::constraint_hessian(int k, const Eigen::V
 }
 
 std::vector<Eigen::VectorXd> QuadrotorWindowProblem::hover_controls() const {
-  return std::vector<Eigen::VectorXd>(scenario_.knots - 1, hover_);
+  return std::vector<Eigen::VectorXd>(scenario_.knots - 1, Eigen::VectorXd(hover_));
 }
 
 }  // namespace diffpills::examples

@@ -52,8 +52,8 @@ struct QuadrotorWindowScenario {
   double thrust_max = 4.0;   // per rotor, N; thrusts are >= 0
 };
 
-// The body's pose at state x: r = x[0:3], q = x[3:7].
-Pose quadrotor_pose(const Eigen::VectorXd& x);
+// The body's pose at state x (13 entries): r = x[0:3], q = x[3:7].
+Pose quadrotor_pose(const Eigen::Ref<const Eigen::VectorXd>& x);
 
 // The smallest phi over the obstacles at state x (whatever the scenario's clearance).
 double quadrotor_min_phi(const QuadrotorWindowScenario& scenario, const Eigen::VectorXd& x);
@@ -62,27 +62,24 @@ double quadrotor_min_phi(const QuadrotorWindowScenario& scenario, const Eigen::V
 // 1/2 (x - goal)'Qf(x - goal) at the end; constraints -clearance <= 0 (phi or the signed
 // distance) for every obstacle at every knot,
 // 0 <= u <= thrust_max, and the final position equal to the goal's; with exact second derivatives
-// (the costs are quadratic).
-class QuadrotorWindowProblem : public trajopt::Problem {
+// (the costs are quadratic). Fixed sizes (problem.hpp): 13 states, 4 controls.
+class QuadrotorWindowProblem : public trajopt::ProblemOf<13, 4> {
  public:
   explicit QuadrotorWindowProblem(QuadrotorWindowScenario scenario);
 
   int state_size() const override { return 13; }
   int control_size() const override { return 4; }
   int knots() const override { return scenario_.knots; }
-  void dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& next,
-                Eigen::MatrixXd& A, Eigen::MatrixXd& B) const override;
-  trajopt::CostExpansion stage_cost(int k, const Eigen::VectorXd& x,
-                                    const Eigen::VectorXd& u) const override;
-  trajopt::CostExpansion terminal_cost(const Eigen::VectorXd& x) const override;
-  trajopt::KnotConstraints constraints(int k, const Eigen::VectorXd& x,
-                                       const Eigen::VectorXd& u) const override;
-  trajopt::KnotConstraints constraint_values(int k, const Eigen::VectorXd& x,
-                                             const Eigen::VectorXd& u) const override;
+  void dynamics(const State& x, const Control& u, State& next, StateMatrix& A,
+                ControlMatrix& B) const override;
+  Cost stage_cost(int k, const State& x, const Control& u) const override;
+  Cost terminal_cost(const State& x) const override;
+  Constraints constraints(int k, const State& x, const Control& u) const override;
+  Constraints constraint_values(int k, const State& x, const Control& u) const override;
   bool has_second_derivatives() const override { return true; }
-  Eigen::MatrixXd dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
-                                   const Eigen::VectorXd& lambda) const override;
-  Eigen::MatrixXd constraint_hessian(int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u,
+  Eigen::MatrixXd dynamics_hessian(const State& x, const Control& u,
+                                   const State& lambda) const override;
+  Eigen::MatrixXd constraint_hessian(int k, const State& x, const Control& u,
                                      const Eigen::VectorXd& mu) const override;
 
   const QuadrotorWindowScenario& scenario() const { return scenario_; }
@@ -91,12 +88,13 @@ class QuadrotorWindowProblem : public trajopt::Problem {
   std::vector<Eigen::VectorXd> hover_controls() const;
 
  private:
-  trajopt::KnotConstraints evaluate_constraints(int k, const Eigen::VectorXd& x,
-                                                const Eigen::VectorXd& u, bool derivatives) const;
+  Constraints evaluate_constraints(int k, const State& x, const Control& u, bool derivatives) const;
 
   QuadrotorWindowScenario scenario_;
-  Eigen::VectorXd hover_;
-  Eigen::MatrixXd Q_, R_, Qf_;
+  State goal_;  // scenario_.goal, checked to have 13 entries
+  Control hover_;
+  StateMatrix Q_, Qf_;
+  Eigen::Matrix4d R_;
 };
 
 }  // namespace diffpills::examples

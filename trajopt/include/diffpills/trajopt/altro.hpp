@@ -65,9 +65,14 @@ struct AltroResult {
 };
 
 // Solves from x0 with the controls as the initial guess (N - 1 of them; the states follow by
-// rollout). Throws std::invalid_argument on sizes that do not match the problem.
-AltroResult solve(const Problem& problem, const Eigen::VectorXd& x0,
+// rollout). Throws std::invalid_argument on sizes that do not match the problem. A fixed-size
+// problem (ProblemOf<5, 2>) runs the solver compiled for those sizes (altro_solver.hpp), a dynamic
+// one the solver compiled once in the library.
+template <int Nx, int Nu>
+AltroResult solve(const ProblemOf<Nx, Nu>& problem, const Eigen::VectorXd& x0,
                   const std::vector<Eigen::VectorXd>& initial_controls,
                   const AltroSettings& settings = {});
 
 }  // namespace diffpills::trajopt
+
+#include "diffpills/trajopt/altro_solver.hpp"  // the template's definition

@@ -10,81 +10,118 @@
 // constraints, for solvers that use the exact Hessian of the Lagrangian (the examples' Ipopt
 // cross-check); ALTRO does not use them. Implementations must be pure: the same inputs give the
 // same outputs.
+//
+// Sizes. ProblemOf<Nx, Nu> fixes n and m at compile time: states, controls, their Jacobians and
+// the cost expansions are then Eigen fixed-size types on the stack, and the solver's inner loops
+// (altro.hpp) allocate nothing for them. Problem = ProblemOf<Eigen::Dynamic, Eigen::Dynamic> takes
+// its sizes at run time (VectorXd, MatrixXd). A knot's constraint rows are a run-time count in
+// both. DynamicProblem<Nx, Nu> (dynamic_problem.hpp) shows a fixed-size problem as a dynamic one,
+// for code written against Problem (the examples' Ipopt cross-check).
+//
+// The last knot has no control. A dynamic problem gets an empty u there and returns du with zero
+// columns; a fixed-size problem gets u = 0 there and its du, if it fills one, is ignored. Either
+// way the constraints and their Hessian must not depend on u at the last knot.
 #pragma once
 
 #include <Eigen/Core>
+#include <stdexcept>
 
 namespace diffpills::trajopt {
 
 // Value and derivatives of one knot's constraints: rows [0, equalities) are equalities e = 0,
-// the rest inequalities c <= 0. At the last knot du has zero columns.
-struct KnotConstraints {
+// the rest inequalities c <= 0.
+template <int Nx, int Nu>
+struct KnotConstraintsOf {
   Eigen::VectorXd value;
-  Eigen::MatrixXd dx;
-  Eigen::MatrixXd du;
+  Eigen::Matrix<double, Eigen::Dynamic, Nx> dx;
+  Eigen::Matrix<double, Eigen::Dynamic, Nu> du;
   int equalities = 0;
 };
 
-// A cost term's value with its gradient and Hessian (Gauss-Newton or exact).
-struct CostExpansion {
+// A cost term's value with its gradient and Hessian (Gauss-Newton or exact). The terminal cost
+// fills value, x and xx only.
+template <int Nx, int Nu>
+struct CostExpansionOf {
   double value = 0.0;
-  Eigen::VectorXd x, u;    // gradients
-  Eigen::MatrixXd xx, uu;  // Hessians
-  Eigen::MatrixXd ux;      // mixed, m x n
+  Eigen::Matrix<double, Nx, 1> x;  // gradients
+  Eigen::Matrix<double, Nu, 1> u;
+  Eigen::Matrix<double, Nx, Nx> xx;  // Hessians
+  Eigen::Matrix<double, Nu, Nu> uu;
+  Eigen::Matrix<double, Nu, Nx> ux;  // mixed, m x n
 };
 
-class Problem {
+template <int Nx, int Nu>
+class ProblemOf {
  public:
-  virtual ~Problem() = default;
+  static constexpr int kStateSize = Nx;    // or Eigen::Dynamic
+  static constexpr int kControlSize = Nu;  // or Eigen::Dynamic
+  using State = Eigen::Matrix<double, Nx, 1>;
+  using Control = Eigen::Matrix<double, Nu, 1>;
+  using StateMatrix = Eigen::Matrix<double, Nx, Nx>;    // A = df/dx
+  using ControlMatrix = Eigen::Matrix<double, Nx, Nu>;  // B = df/du
+  using Constraints = KnotConstraintsOf<Nx, Nu>;
+  using Cost = CostExpansionOf<Nx, Nu>;
 
-  virtual int state_size() const = 0;
+  virtual ~ProblemOf() = default;
+
+  virtual int state_size() const = 0;  // Nx when fixed
   virtual int control_size() const = 0;
   virtual int knots() const = 0;  // N: states x_0..x_{N-1}, controls u_0..u_{N-2}
 
   // next = f(x, u) with A = df/dx (n x n), B = df/du (n x m).
-  virtual void dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd& next,
-                        Eigen::MatrixXd& A, Eigen::MatrixXd& B) const = 0;
+  virtual void dynamics(const State& x, const Control& u, State& next, StateMatrix& A,
+                        ControlMatrix& B) const = 0;
 
   // l_k(x, u) for k < N - 1 and l_N(x) for the last knot (expansion.u and friends unused there).
-  virtual CostExpansion stage_cost(int k, const Eigen::VectorXd& x,
-                                   const Eigen::VectorXd& u) const = 0;
-  virtual CostExpansion terminal_cost(const Eigen::VectorXd& x) const = 0;
+  virtual Cost stage_cost(int k, const State& x, const Control& u) const = 0;
+  virtual Cost terminal_cost(const State& x) const = 0;
 
-  // Constraints at knot k (k = N - 1: terminal, u empty). The row count of a knot must not change
-  // between calls. The default has none.
-  virtual KnotConstraints constraints(int k, const Eigen::VectorXd& x,
-                                      const Eigen::VectorXd& u) const;
+  // Constraints at knot k (k = N - 1: terminal, see above for u). The row count of a knot must
+  // not change between calls. The default has none.
+  virtual Constraints constraints(int /*k*/, const State& x, const Control& u) const {
+    Constraints none;
+    none.value.resize(0);
+    none.dx.resize(0, x.size());
+    none.du.resize(0, u.size());
+    return none;
+  }
 
   // Values only, for the line search and the multiplier updates, which need no derivatives.
   // The defaults call the full evaluations; a problem overrides them when that saves work
   // (measured on the car-bus problem: the line search's derivative evaluations were a fifth of
   // the solve).
-  virtual double stage_cost_value(int k, const Eigen::VectorXd& x, const Eigen::VectorXd& u) const {
+  virtual double stage_cost_value(int k, const State& x, const Control& u) const {
     return stage_cost(k, x, u).value;
   }
-  virtual double terminal_cost_value(const Eigen::VectorXd& x) const {
-    return terminal_cost(x).value;
-  }
+  virtual double terminal_cost_value(const State& x) const { return terminal_cost(x).value; }
   // value and equalities filled; dx and du may be left empty.
-  virtual KnotConstraints constraint_values(int k, const Eigen::VectorXd& x,
-                                            const Eigen::VectorXd& u) const {
+  virtual Constraints constraint_values(int k, const State& x, const Control& u) const {
     return constraints(k, x, u);
   }
 
   // Second derivatives. A problem that returns true here implements the two functions below, and
-  // its CostExpansion Hessians are exact (not Gauss-Newton); the defaults have none and throw
+  // its cost expansions' Hessians are exact (not Gauss-Newton); the defaults have none and throw
   // std::logic_error.
   virtual bool has_second_derivatives() const { return false; }
   // The Hessian of lambda' f(x, u) with respect to [x; u], (n + m) x (n + m), for lambda in R^n.
-  // Both throw std::invalid_argument for vectors of the wrong size (require_size below).
-  virtual Eigen::MatrixXd dynamics_hessian(const Eigen::VectorXd& x, const Eigen::VectorXd& u,
-                                           const Eigen::VectorXd& lambda) const;
+  // A dynamic problem throws std::invalid_argument for vectors of the wrong size (require_size
+  // below).
+  virtual Eigen::MatrixXd dynamics_hessian(const State& /*x*/, const Control& /*u*/,
+                                           const State& /*lambda*/) const {
+    throw std::logic_error("dynamics_hessian: this problem supplies no second derivatives");
+  }
   // The Hessian of mu' [e_k; c_k](x, u) with respect to [x; u] (x alone at the last knot), for one
   // multiplier per row of constraints(k, x, u).
-  virtual Eigen::MatrixXd constraint_hessian(int k, const Eigen::VectorXd& x,
-                                             const Eigen::VectorXd& u,
-                                             const Eigen::VectorXd& mu) const;
+  virtual Eigen::MatrixXd constraint_hessian(int /*k*/, const State& /*x*/, const Control& /*u*/,
+                                             const Eigen::VectorXd& /*mu*/) const {
+    throw std::logic_error("constraint_hessian: this problem supplies no second derivatives");
+  }
 };
+
+// Sizes chosen at run time.
+using Problem = ProblemOf<Eigen::Dynamic, Eigen::Dynamic>;
+using KnotConstraints = KnotConstraintsOf<Eigen::Dynamic, Eigen::Dynamic>;
+using CostExpansion = CostExpansionOf<Eigen::Dynamic, Eigen::Dynamic>;
 
 // Throws std::invalid_argument("<name>: expected <size> entries, got <v.size()>") unless v has size
 // entries: for the second-derivative functions, whose fixed-size models would otherwise read past

@@ -48,8 +48,10 @@ void rk4_step(const Derivative& derivative, double h, const Eigen::Matrix<double
     StateMatrix Fx;
     ControlMatrix Fu;
     derivative(stage, u, k, Fx, Fu);
-    const StateMatrix kx = Fx * stage_x;
-    const ControlMatrix ku = Fx * stage_u + Fu;
+    // The first stage is x itself (stage_x = I, stage_u = 0): its products are Fx and Fu exactly,
+    // and skipping them saves a quarter of the n x n x n products (the quadrotor: n = 13).
+    const StateMatrix kx = i == 0 ? Fx : StateMatrix(Fx * stage_x);
+    const ControlMatrix ku = i == 0 ? Fu : ControlMatrix(Fx * stage_u + Fu);
     next += weights[i] * k;
     A += weights[i] * kx;
     B += weights[i] * ku;

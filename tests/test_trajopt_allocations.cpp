@@ -1,0 +1,127 @@
+// The fixed-size solver's inner loops allocate nothing (issue 13): this binary counts every heap
+// allocation (it defines malloc and its relatives over glibc's own, which Eigen's matrices and
+// operator new both reach) and compares whole solves that differ only in how many iLQR iterations
+// they run. Its own binary, since the definitions apply to everything linked in; not under
+// AddressSanitizer, which defines malloc itself (the test is skipped there, and labelled
+// no_sanitize).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "diffpills/trajopt/altro.hpp"
+#include "diffpills/trajopt/car.hpp"
+#include "diffpills/trajopt/dynamic_problem.hpp"
+
+namespace {
+std::atomic<long> allocations{0};
+}  // namespace
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kCounting = false;
+#else
+constexpr bool kCounting = true;
+extern "C" {
+void* __libc_malloc(std::size_t size);
+void* __libc_calloc(std::size_t count, std::size_t size);
+void* __libc_realloc(void* p, std::size_t size);
+void* __libc_memalign(std::size_t alignment, std::size_t size);
+void __libc_free(void* p);
+
+void* malloc(std::size_t size) noexcept {
+  ++allocations;
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t count, std::size_t size) noexcept {
+  ++allocations;
+  return __libc_calloc(count, size);
+}
+void* realloc(void* p, std::size_t size) noexcept {
+  ++allocations;
+  return __libc_realloc(p, size);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t size) noexcept {
+  ++allocations;
+  return __libc_memalign(alignment, size);
+}
+void free(void* p) noexcept { __libc_free(p); }
+}
+#endif
+
+namespace diffpills::trajopt {
+namespace {
+
+// The kinematic car (car.hpp) driven from rest to a point 10 m ahead and 3 m aside, quadratic
+// costs, no constraints: nonlinear, so iLQR takes several iterations.
+class CarToAPoint : public ProblemOf<5, 2> {
+ public:
+  int state_size() const override { return 5; }
+  int control_size() const override { return 2; }
+  int knots() const override { return 41; }
+  void dynamics(const State& x, const Control& u, State& next, StateMatrix& A,
+                ControlMatrix& B) const override {
+    car_.step(0.1, x, u, next, A, B);
+  }
+  Cost stage_cost(int, const State& x, const Control& u) const override {
+    return {0.5 * 0.01 * (x - goal_).squaredNorm() + 0.5 * 0.1 * u.squaredNorm(),
+            0.01 * (x - goal_),
+            0.1 * u,
+            0.01 * StateMatrix::Identity(),
+            0.1 * Eigen::Matrix2d::Identity(),
+            Eigen::Matrix<double, 2, 5>::Zero()};
+  }
+  Cost terminal_cost(const State& x) const override {
+    return {0.5 * 100.0 * (x - goal_).squaredNorm(),
+            100.0 * (x - goal_),
+            Control::Zero(),
+            100.0 * StateMatrix::Identity(),
+            Eigen::Matrix2d::Zero(),
+            Eigen::Matrix<double, 2, 5>::Zero()};
+  }
+
+ private:
+  Car car_{2.5};
+  State goal_ = (State() << 10.0, 3.0, 0.0, 0.0, 0.0).finished();
+};
+
+// Allocations of one solve capped at `iterations` iLQR iterations (the polish, which builds sparse
+// matrices, off).
+template <class Problem>
+long allocations_of_solve(const Problem& problem, int iterations, int* ran) {
+  AltroSettings settings;
+  settings.max_total_iterations = iterations;
+  settings.polish = false;
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Zero(5);
+  const std::vector<Eigen::VectorXd> guess(40, Eigen::VectorXd::Zero(2));
+  const long before = allocations.load();
+  const AltroResult result = solve(problem, x0, guess, settings);
+  const long used = allocations.load() - before;
+  *ran = result.iterations;
+  return used;
+}
+
+TEST(TrajoptAllocations, FixedSizeIterationsAllocateNothing) {
+  if (!kCounting) GTEST_SKIP() << "AddressSanitizer owns malloc";
+  const CarToAPoint problem;
+  int short_run = 0, long_run = 0;
+  const long one = allocations_of_solve(problem, 1, &short_run);
+  const long many = allocations_of_solve(problem, 1000, &long_run);
+  ASSERT_EQ(short_run, 1);
+  ASSERT_GE(long_run, 5);  // the extra iterations exist
+  EXPECT_EQ(many, one) << long_run << " iterations";
+  // The counter sees the run-time-sized solver's per-iteration allocations: the comparison above
+  // could fail.
+  const DynamicProblem<5, 2> dynamic(problem);
+  const long dynamic_one = allocations_of_solve(dynamic, 1, &short_run);
+  const long dynamic_many = allocations_of_solve(dynamic, 1000, &long_run);
+  EXPECT_GT(dynamic_many, dynamic_one + long_run);
+  std::printf(
+      "fixed sizes: %ld allocations for 1 iteration, %ld for %d; run-time sizes: %ld, %ld\n", one,
+      many, long_run, dynamic_one, dynamic_many);
+}
+
+}  // namespace
+}  // namespace diffpills::trajopt
