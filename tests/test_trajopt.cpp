@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <cmath>
 #include <cstdint>
 #include <iostream>
@@ -148,30 +149,244 @@ TEST(Trajopt, FixedAndDynamicSizesSolveTheSame) {
   }
 }
 
-// A problem whose constraint derivatives do not have one row per value is refused by name
-// instead of being read past.
-TEST(Trajopt, RefusesConstraintsOfTheWrongShape) {
-  class Misshapen : public LinearQuadratic {
-   public:
-    using LinearQuadratic::LinearQuadratic;
-    KnotConstraints constraints(int k, const VectorXd& x, const VectorXd& u) const override {
-      KnotConstraints c;
-      c.value = VectorXd::Constant(2, -1.0);
-      c.dx = MatrixXd::Zero(1, x.size());  // one row short
-      c.du = MatrixXd::Zero(k + 1 < knots() ? 2 : 1, u.size());
-      return c;
+// LinearQuadraticOf with equality rows that couple state and control, S x_k + T u_k = s at every
+// stage knot and E x = t at the last, so that the constraint terms reach Qux in the backward pass.
+template <int Nx, int Nu>
+class CoupledLinearQuadraticOf : public LinearQuadraticOf<Nx, Nu> {
+ public:
+  using P = ProblemOf<Nx, Nu>;
+  using typename P::Constraints;
+  using typename P::Control;
+  using typename P::State;
+
+  CoupledLinearQuadraticOf(const LinearQuadraticOf<Nx, Nu>& base, const MatrixXd& S,
+                           const MatrixXd& T, const VectorXd& s, const MatrixXd& E,
+                           const VectorXd& t)
+      : LinearQuadraticOf<Nx, Nu>(base), S_(S), T_(T), s_(s), E_(E), t_(t) {}
+  Constraints constraints(int k, const State& x, const Control& u) const override {
+    Constraints c;
+    if (k + 1 < this->knots()) {
+      c.value = S_ * x + T_ * u - s_;
+      c.dx = S_;
+      c.du = T_;
+    } else {
+      c.value = E_ * x - t_;
+      c.dx = E_;
+      c.du.setZero(E_.rows(), u.size());
     }
-  };
-  const Misshapen problem(MatrixXd::Identity(2, 2), MatrixXd::Identity(2, 1),
-                          MatrixXd::Identity(2, 2), MatrixXd::Identity(1, 1),
-                          MatrixXd::Identity(2, 2), 4);
+    c.equalities = static_cast<int>(c.value.size());
+    return c;
+  }
+
+ private:
+  MatrixXd S_, T_;
+  VectorXd s_;
+  MatrixXd E_;
+  VectorXd t_;
+};
+
+// The same problem as one equality-constrained QP in z = [x_0 .. x_{N-1}, u_0 .. u_{N-2}], solved
+// through its dense KKT system [H D'; D 0] [z; nu] = [0; b]: the controls.
+std::vector<VectorXd> coupled_qp_controls(const MatrixXd& A, const MatrixXd& B, const MatrixXd& Q,
+                                          const MatrixXd& R, const MatrixXd& Qf, const MatrixXd& S,
+                                          const MatrixXd& T, const VectorXd& s, const MatrixXd& E,
+                                          const VectorXd& t, const VectorXd& x0, int N) {
+  const Eigen::Index n = A.rows(), m = B.cols(), p = S.rows(), q = E.rows();
+  const Eigen::Index variables = N * n + (N - 1) * m;
+  const Eigen::Index rows = N * n + (N - 1) * p + q;
+  const auto xi = [&](int k) { return k * n; };
+  const auto ui = [&](int k) { return N * n + k * m; };
+  MatrixXd H = MatrixXd::Zero(variables, variables);
+  MatrixXd D = MatrixXd::Zero(rows, variables);
+  VectorXd b = VectorXd::Zero(rows);
+  for (int k = 0; k + 1 < N; ++k) {
+    H.block(xi(k), xi(k), n, n) = Q;
+    H.block(ui(k), ui(k), m, m) = R;
+  }
+  H.block(xi(N - 1), xi(N - 1), n, n) = Qf;
+  Eigen::Index row = 0;
+  D.block(row, xi(0), n, n).setIdentity();
+  b.segment(row, n) = x0;
+  row += n;
+  for (int k = 0; k + 1 < N; ++k, row += n) {  // x_{k+1} - A x_k - B u_k = 0
+    D.block(row, xi(k + 1), n, n).setIdentity();
+    D.block(row, xi(k), n, n) = -A;
+    D.block(row, ui(k), n, m) = -B;
+  }
+  for (int k = 0; k + 1 < N; ++k, row += p) {
+    D.block(row, xi(k), p, n) = S;
+    D.block(row, ui(k), p, m) = T;
+    b.segment(row, p) = s;
+  }
+  D.block(row, xi(N - 1), q, n) = E;
+  b.segment(row, q) = t;
+  MatrixXd kkt = MatrixXd::Zero(variables + rows, variables + rows);
+  kkt.topLeftCorner(variables, variables) = H;
+  kkt.topRightCorner(variables, rows) = D.transpose();
+  kkt.bottomLeftCorner(rows, variables) = D;
+  VectorXd rhs = VectorXd::Zero(variables + rows);
+  rhs.tail(rows) = b;
+  const VectorXd z = kkt.fullPivLu().solve(rhs);
+  std::vector<VectorXd> controls(N - 1);
+  for (int k = 0; k + 1 < N; ++k) controls[k] = z.segment(ui(k), m);
+  return controls;
+}
+
+// ALTRO on random LQ problems with coupled equalities against the KKT solution. The augmented
+// Lagrangian is exactly quadratic for fixed multipliers, so with exact Q terms (the constraint
+// rows' C_u' mu C_x in Qux included) each inner solve is one Newton step and a convergence check.
+template <int Nx, int Nu>
+void expect_coupled_qp_controls(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  for (int trial = 0; trial < 10; ++trial) {
+    const int n = 4, m = 2, N = 20;
+    const MatrixXd A = MatrixXd::Identity(n, n) + 0.1 * random_matrix(rng, n, n);
+    const MatrixXd B = 0.1 * random_matrix(rng, n, m);
+    const MatrixXd Q = MatrixXd::Identity(n, n);
+    const MatrixXd R = 0.5 * MatrixXd::Identity(m, m);
+    const MatrixXd Qf = 10.0 * Q;
+    const MatrixXd S = random_matrix(rng, 1, n), T = random_matrix(rng, 1, m);
+    const VectorXd s = random_matrix(rng, 1, 1), t = random_matrix(rng, 1, 1);
+    const MatrixXd E = random_matrix(rng, 1, n);
+    const VectorXd x0 = random_matrix(rng, n, 1);
+    const CoupledLinearQuadraticOf<Nx, Nu> problem(LinearQuadraticOf<Nx, Nu>(A, B, Q, R, Qf, N), S,
+                                                   T, s, E, t);
+    const AltroResult result = solve(problem, x0, std::vector<VectorXd>(N - 1, VectorXd::Zero(m)));
+    ASSERT_EQ(result.status, AltroStatus::kSolved) << to_string(result.status);
+    const std::vector<VectorXd> reference =
+        coupled_qp_controls(A, B, Q, R, Qf, S, T, s, E, t, x0, N);
+    for (int k = 0; k + 1 < N; ++k) {
+      ASSERT_LE((result.controls[k] - reference[k]).norm(), 1e-5 * (1 + reference[k].norm()))
+          << "trial " << trial << " knot " << k;
+    }
+    EXPECT_LE(result.iterations, 2 * result.outer_iterations) << "trial " << trial;
+  }
+}
+
+TEST(Trajopt, CoupledEqualitiesMatchTheKktSolution) {
+  expect_coupled_qp_controls<Eigen::Dynamic, Eigen::Dynamic>(11);
+  expect_coupled_qp_controls<4, 2>(11);
+}
+
+// A problem whose constraints break problem.hpp's rules is refused by name instead of being read
+// past: derivative rows that do not match the values (dx, or du at a stage knot, at either kind
+// of size), a row count that changes between calls or between constraints and
+// constraint_values, and an equality count outside [0, rows].
+enum class Flaw { kShortDx, kShortStageDu, kGrowingRows, kMoreValues, kTooManyEqualities };
+
+template <int Nx, int Nu>
+class FlawedOf : public LinearQuadraticOf<Nx, Nu> {
+ public:
+  using P = ProblemOf<Nx, Nu>;
+  using typename P::Constraints;
+  using typename P::Control;
+  using typename P::State;
+
+  explicit FlawedOf(Flaw flaw)
+      : LinearQuadraticOf<Nx, Nu>(MatrixXd::Identity(2, 2), MatrixXd::Identity(2, 1),
+                                  MatrixXd::Identity(2, 2), MatrixXd::Identity(1, 1),
+                                  MatrixXd::Identity(2, 2), 4),
+        flaw_(flaw) {}
+  Constraints constraints(int k, const State& x, const Control& u) const override {
+    ++calls_;
+    const bool stage = k + 1 < this->knots();
+    Eigen::Index rows = 2;
+    if (flaw_ == Flaw::kGrowingRows && calls_ > 4) rows = 3;  // after the first call per knot
+    Constraints c;
+    c.value = VectorXd::Constant(rows, -1.0);
+    c.dx.setZero(flaw_ == Flaw::kShortDx ? rows - 1 : rows, x.size());
+    c.du.setZero(flaw_ == Flaw::kShortStageDu && stage ? rows - 1 : rows, u.size());
+    c.equalities = flaw_ == Flaw::kTooManyEqualities ? 3 : 0;
+    return c;
+  }
+  Constraints constraint_values(int k, const State& x, const Control& u) const override {
+    Constraints c = constraints(k, x, u);
+    if (flaw_ == Flaw::kMoreValues) c.value = VectorXd::Constant(5, -1.0);
+    return c;
+  }
+
+ private:
+  Flaw flaw_;
+  mutable int calls_ = 0;
+};
+
+template <int Nx, int Nu>
+void expect_refused(Flaw flaw, const std::string& prefix) {
+  const FlawedOf<Nx, Nu> problem(flaw);
   try {
     solve(problem, VectorXd::Ones(2), std::vector<VectorXd>(3, VectorXd::Zero(1)));
-    ADD_FAILURE() << "no exception";
+    ADD_FAILURE() << prefix << ": no exception";
   } catch (const std::invalid_argument& error) {
-    EXPECT_EQ(std::string(error.what()).rfind("trajopt: constraints(3) returned 2 values", 0), 0u)
-        << error.what();
+    EXPECT_EQ(std::string(error.what()).rfind(prefix, 0), 0u) << error.what();
   }
+}
+
+TEST(Trajopt, RefusesConstraintsThatBreakTheRowRules) {
+  expect_refused<Eigen::Dynamic, Eigen::Dynamic>(Flaw::kShortDx,
+                                                 "trajopt: constraints(0) returned 2 values");
+  expect_refused<2, 1>(Flaw::kShortDx, "trajopt: constraints(0) returned 2 values");
+  expect_refused<Eigen::Dynamic, Eigen::Dynamic>(Flaw::kShortStageDu,
+                                                 "trajopt: constraints(0) returned 2 values");
+  expect_refused<2, 1>(Flaw::kShortStageDu, "trajopt: constraints(0) returned 2 values");
+  expect_refused<2, 1>(Flaw::kGrowingRows, "trajopt: constraint_values(0) returned 3 values");
+  expect_refused<2, 1>(Flaw::kMoreValues, "trajopt: constraint_values(0) returned 5 values");
+  expect_refused<Eigen::Dynamic, Eigen::Dynamic>(
+      Flaw::kTooManyEqualities, "trajopt: constraints(0) returned 2 values (3 equalities)");
+}
+
+// NaN or infinity from the problem ends the solve as kNonFinite, never as kSolved: before the
+// check, a NaN gradient gave NaN steps that std::max read as zero, "converged". A non-finite x0
+// is refused.
+enum class Poison { kNone, kGradient, kConstraintValue, kDynamics };
+
+class PoisonedLinearQuadratic : public LinearQuadratic {
+ public:
+  explicit PoisonedLinearQuadratic(Poison poison)
+      : LinearQuadratic(MatrixXd::Identity(2, 2), MatrixXd::Identity(2, 1),
+                        MatrixXd::Identity(2, 2), MatrixXd::Identity(1, 1),
+                        MatrixXd::Identity(2, 2), 6),
+        poison_(poison) {}
+  CostExpansion stage_cost(int k, const VectorXd& x, const VectorXd& u) const override {
+    CostExpansion l = LinearQuadratic::stage_cost(k, x, u);
+    if (poison_ == Poison::kGradient && k == 2) l.u(0) = std::nan("");
+    return l;
+  }
+  KnotConstraints constraints(int k, const VectorXd& x, const VectorXd& u) const override {
+    KnotConstraints c;
+    c.value = VectorXd::Constant(
+        1, poison_ == Poison::kConstraintValue && k == 3 ? std::nan("") : x(0) - 10.0);
+    c.dx = MatrixXd::Zero(1, x.size());
+    c.dx(0, 0) = 1.0;
+    c.du = MatrixXd::Zero(1, u.size());
+    return c;
+  }
+  void dynamics(const VectorXd& x, const VectorXd& u, VectorXd& next, MatrixXd& A,
+                MatrixXd& B) const override {
+    LinearQuadratic::dynamics(x, u, next, A, B);
+    if (poison_ == Poison::kDynamics && x(1) > 0.5) next(1) = HUGE_VAL;
+  }
+
+ private:
+  Poison poison_;
+};
+
+TEST(Trajopt, NonFiniteProblemValuesAreNotSolved) {
+  const std::vector<VectorXd> guess(5, VectorXd::Zero(1));
+  for (const Poison poison : {Poison::kGradient, Poison::kConstraintValue, Poison::kDynamics}) {
+    const PoisonedLinearQuadratic problem(poison);
+    const AltroResult result = solve(problem, VectorXd::Ones(2), guess);
+    EXPECT_EQ(result.status, AltroStatus::kNonFinite)
+        << static_cast<int>(poison) << ": " << to_string(result.status);
+    if (poison != Poison::kGradient) {  // NaN and infinite values are reported as such
+      EXPECT_FALSE(std::isfinite(result.max_violation)) << static_cast<int>(poison);
+    }
+  }
+  // The same problem without poison solves: the status above comes from the NaN.
+  const PoisonedLinearQuadratic clean(Poison::kNone);
+  EXPECT_EQ(solve(clean, VectorXd::Ones(2), guess).status, AltroStatus::kSolved);
+  VectorXd x0 = VectorXd::Ones(2);
+  x0(1) = std::nan("");
+  EXPECT_THROW(solve(clean, x0, guess), std::invalid_argument);
 }
 
 TEST(Trajopt, Rk4JacobiansMatchCentralDifferences) {

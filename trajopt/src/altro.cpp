@@ -20,6 +20,8 @@ const char* to_string(AltroStatus status) {
       return "max_iterations";
     case AltroStatus::kRegularizationFailure:
       return "regularization_failure";
+    case AltroStatus::kNonFinite:
+      return "non_finite";
   }
   return "unknown";
 }

@@ -49,6 +49,8 @@ enum class AltroStatus {
   kSolved,                 // max violation <= constraint_tolerance and the inner loop converged
   kMaxIterations,          // an iteration cap was reached first
   kRegularizationFailure,  // rho exceeded regularization_max
+  kNonFinite,  // the problem returned NaN or infinity: at the initial guess (a state or the cost)
+               // or in the derivatives of the backward pass
 };
 
 const char* to_string(AltroStatus status);
@@ -65,9 +67,10 @@ struct AltroResult {
 };
 
 // Solves from x0 with the controls as the initial guess (N - 1 of them; the states follow by
-// rollout). Throws std::invalid_argument on sizes that do not match the problem. A fixed-size
-// problem (ProblemOf<5, 2>) runs the solver compiled for those sizes (altro_solver.hpp), a dynamic
-// one the solver compiled once in the library.
+// rollout). Throws std::invalid_argument on sizes that do not match the problem, a non-finite x0
+// or control, fewer than 2 knots, and constraints whose rows break problem.hpp's rules. A
+// fixed-size problem (ProblemOf<5, 2>) runs the solver compiled for those sizes (altro_solver.hpp),
+// a dynamic one the solver compiled once in the library.
 template <int Nx, int Nu>
 AltroResult solve(const ProblemOf<Nx, Nu>& problem, const Eigen::VectorXd& x0,
                   const std::vector<Eigen::VectorXd>& initial_controls,

@@ -30,27 +30,23 @@ inline double penalty_weight(const Eigen::VectorXd& value, int equalities, Eigen
   return (row < equalities || value(row) > 0.0 || lambda > 0.0) ? mu : 0.0;
 }
 
-// The largest |e| of the equalities and positive c of the inequalities.
+// max(a, b), but NaN if either is: std::max(0.0, NaN) is 0, which would let a problem that
+// returned NaN look satisfied.
+inline double max_or_nan(double a, double b) { return (a > b || std::isnan(a)) ? a : b; }
+
+// The largest |e| of the equalities and positive c of the inequalities; NaN if any value is.
 inline double violation(const Eigen::VectorXd& value, int equalities) {
   double worst = 0.0;
   for (Eigen::Index i = 0; i < value.size(); ++i) {
-    worst = std::max(worst, i < equalities ? std::abs(value(i)) : value(i));
+    worst = max_or_nan(worst, i < equalities ? std::abs(value(i)) : value(i));
   }
   return worst;
 }
 
-// A knot's constraints must have one derivative row per value (problem.hpp); a problem that breaks
-// this would otherwise have the solver read past its matrices.
-template <class Constraints>
-void require_rows(const Constraints& c, int k, bool has_control, int nx, int nu) {
-  const auto rows = c.value.size();
-  if (c.dx.rows() != rows || c.dx.cols() != nx ||
-      (has_control && (c.du.rows() != rows || c.du.cols() != nu))) {
-    throw std::invalid_argument(
-        "trajopt: constraints(" + std::to_string(k) + ") returned " + std::to_string(rows) +
-        " values with a " + std::to_string(c.dx.rows()) + " x " + std::to_string(c.dx.cols()) +
-        " dx and a " + std::to_string(c.du.rows()) + " x " + std::to_string(c.du.cols()) + " du");
-  }
+// The largest |v_i|, NaN if any entry is.
+template <class Vector>
+double largest_magnitude(const Vector& v) {
+  return v.size() == 0 ? 0.0 : v.cwiseAbs().template maxCoeff<Eigen::PropagateNaN>();
 }
 
 template <int Nx, int Nu>
@@ -89,13 +85,20 @@ class AltroSolver {
       return Control::Zero();
     }
   }
+  // Every read of a knot's constraints checks them first (problem.hpp): as many rows as the
+  // knot's multipliers (the first call's count), 0 <= equalities <= rows, and when `derivatives`
+  // a rows x n dx and, before the last knot, a rows x m du. A problem that broke this would
+  // otherwise have the solver read past its matrices or its multipliers.
+  void check_rows(const Constraints& c, int k, bool derivatives) const;
   void rollout(Rollout& r) const;
+  static bool finite_states(const Rollout& r);
   double problem_cost(const Rollout& r) const;
   double augmented_cost(const Rollout& r) const;
   double max_violation(const Rollout& r) const;
   template <class Gradient, class Hessian>
   void add_terminal_constraints(const Constraints& c, Gradient& Vx, Hessian& Vxx) const;
-  bool backward_pass(const Rollout& r);
+  enum class Pass { kDone, kIndefinite, kNonFinite };
+  Pass backward_pass(const Rollout& r);
   bool forward_pass(Rollout& r, double& cost);
   void update_multipliers(const Rollout& r);
   double total_violation(const Rollout& r) const;
@@ -134,11 +137,40 @@ bool AltroSolver<Nx, Nu>::grow_regularization() {
 }
 
 template <int Nx, int Nu>
+void AltroSolver<Nx, Nu>::check_rows(const Constraints& c, int k, bool derivatives) const {
+  const Eigen::Index rows = c.value.size();
+  const bool has_control = k + 1 < n_;  // the last knot's du is ignored
+  const Eigen::Index nx = problem_.state_size(), nu = problem_.control_size();
+  if (rows == lambda_[k].size() && c.equalities >= 0 && c.equalities <= rows &&
+      (!derivatives || (c.dx.rows() == rows && c.dx.cols() == nx &&
+                        (!has_control || (c.du.rows() == rows && c.du.cols() == nu))))) {
+    return;
+  }
+  const auto shape = [](const auto& m) {
+    return std::to_string(m.rows()) + " x " + std::to_string(m.cols());
+  };
+  std::string what =
+      "trajopt: " + std::string(derivatives ? "constraints(" : "constraint_values(") +
+      std::to_string(k) + ") returned " + std::to_string(rows) + " values (" +
+      std::to_string(c.equalities) + " equalities)";
+  if (derivatives) what += " with a " + shape(c.dx) + " dx and a " + shape(c.du) + " du";
+  what += "; knot " + std::to_string(k) + " has " + std::to_string(lambda_[k].size()) +
+          " rows, each derivative matrix one row per value, dx " + std::to_string(nx) + " columns" +
+          (has_control ? ", du " + std::to_string(nu) : std::string());
+  throw std::invalid_argument(what);
+}
+
+template <int Nx, int Nu>
 void AltroSolver<Nx, Nu>::rollout(Rollout& r) const {
   r.x[0] = x0_;
   for (int k = 0; k + 1 < n_; ++k) {
     problem_.dynamics(r.x[k], r.u[k], r.x[k + 1], r.A[k], r.B[k]);
   }
+}
+
+template <int Nx, int Nu>
+bool AltroSolver<Nx, Nu>::finite_states(const Rollout& r) {
+  return std::all_of(r.x.begin(), r.x.end(), [](const State& x) { return x.allFinite(); });
 }
 
 template <int Nx, int Nu>
@@ -154,6 +186,7 @@ double AltroSolver<Nx, Nu>::augmented_cost(const Rollout& r) const {
   double cost = problem_cost(r);
   for (int k = 0; k < n_; ++k) {
     const Constraints c = problem_.constraint_values(k, r.x[k], control(r, k));
+    check_rows(c, k, false);
     const Eigen::VectorXd& lambda = lambda_[k];
     for (Eigen::Index i = 0; i < c.value.size(); ++i) {
       const double w = penalty_weight(c.value, c.equalities, i, lambda(i), mu_);
@@ -168,7 +201,8 @@ double AltroSolver<Nx, Nu>::max_violation(const Rollout& r) const {
   double worst = 0.0;
   for (int k = 0; k < n_; ++k) {
     const Constraints c = problem_.constraint_values(k, r.x[k], control(r, k));
-    worst = std::max(worst, violation(c.value, c.equalities));
+    check_rows(c, k, false);
+    worst = max_or_nan(worst, violation(c.value, c.equalities));
   }
   return worst;
 }
@@ -199,19 +233,23 @@ void AltroSolver<Nx, Nu>::add_terminal_constraints(const Constraints& c, Gradien
 // The expected change for a step alpha d is alpha sum d'Qu + alpha^2 / 2 sum d'Quu d.
 // The constraint terms are summed row by row over the rows with a nonzero g or weight (see
 // add_terminal_constraints).
+// kIndefinite when Quu + rho I has no Cholesky factor (grow rho and retry). kNonFinite when a
+// gain is NaN or infinite: the problem returned one along the rollout (a NaN in V reaches every
+// earlier knot's Quu and Qu, and Eigen's LLT passes NaN through without failing), and no rho
+// repairs that.
 template <int Nx, int Nu>
-bool AltroSolver<Nx, Nu>::backward_pass(const Rollout& r) {
+typename AltroSolver<Nx, Nu>::Pass AltroSolver<Nx, Nu>::backward_pass(const Rollout& r) {
   const Cost terminal = problem_.terminal_cost(r.x[n_ - 1]);
   State Vx = terminal.x;
   StateMatrix Vxx = terminal.xx;
   const Constraints last = problem_.constraints(n_ - 1, r.x[n_ - 1], no_control_);
-  require_rows(last, n_ - 1, false, problem_.state_size(), problem_.control_size());
+  check_rows(last, n_ - 1, true);
   add_terminal_constraints(last, Vx, Vxx);
   expected_linear_ = expected_quadratic_ = 0.0;
   for (int k = n_ - 2; k >= 0; --k) {
     const Cost l = problem_.stage_cost(k, r.x[k], r.u[k]);
     const Constraints c = problem_.constraints(k, r.x[k], r.u[k]);
-    require_rows(c, k, true, problem_.state_size(), problem_.control_size());
+    check_rows(c, k, true);
     const StateMatrix& A = r.A[k];
     const ControlMatrix& B = r.B[k];
     State Qx = l.x;
@@ -245,11 +283,12 @@ bool AltroSolver<Nx, Nu>::backward_pass(const Rollout& r) {
     ControlSquare regularized = Quu;
     regularized.diagonal().array() += rho_;
     const Eigen::LLT<ControlSquare> llt(regularized);
-    if (llt.info() != Eigen::Success) return false;
+    if (llt.info() != Eigen::Success) return Pass::kIndefinite;
     Gain& K = K_[k];
     Control& d = d_[k];
     K = -llt.solve(Qux);
     d = -llt.solve(Qu);
+    if (!K.allFinite() || !d.allFinite()) return Pass::kNonFinite;
     const Control Quu_d = Quu * d;
     Vx = Qx;
     Vx.noalias() += K.transpose() * (Quu_d + Qu);
@@ -262,7 +301,7 @@ bool AltroSolver<Nx, Nu>::backward_pass(const Rollout& r) {
     expected_linear_ += d.dot(Qu);
     expected_quadratic_ += 0.5 * d.dot(Quu_d);
   }
-  return true;
+  return Pass::kDone;
 }
 
 // Backtracking from alpha = 1: u = ubar + K (x - xbar) + alpha d, accepted when the actual over
@@ -283,7 +322,7 @@ bool AltroSolver<Nx, Nu>::forward_pass(Rollout& r, double& cost) {
     const double expected = -(alpha * expected_linear_ + alpha * alpha * expected_quadratic_);
     const double ratio = (cost - new_cost) / expected;
     if (std::isfinite(new_cost) && expected > 0.0 && ratio >= settings_.line_search_lower &&
-        ratio <= settings_.line_search_upper) {
+        ratio <= settings_.line_search_upper && finite_states(candidate)) {
       std::swap(r, candidate);  // the old rollout's storage becomes the next trial's
       cost = new_cost;
       return true;
@@ -297,6 +336,7 @@ template <int Nx, int Nu>
 void AltroSolver<Nx, Nu>::update_multipliers(const Rollout& r) {
   for (int k = 0; k < n_; ++k) {
     const Constraints c = problem_.constraint_values(k, r.x[k], control(r, k));
+    check_rows(c, k, false);
     Eigen::VectorXd& lambda = lambda_[k];
     for (Eigen::Index i = 0; i < lambda.size(); ++i) {
       lambda(i) += mu_ * c.value(i);
@@ -310,13 +350,13 @@ void AltroSolver<Nx, Nu>::update_multipliers(const Rollout& r) {
 // initial state and the dynamics (exact after a rollout, not after a polish).
 template <int Nx, int Nu>
 double AltroSolver<Nx, Nu>::total_violation(const Rollout& r) const {
-  double worst = std::max(max_violation(r), (r.x[0] - x0_).template lpNorm<Eigen::Infinity>());
+  double worst = max_or_nan(max_violation(r), largest_magnitude(r.x[0] - x0_));
   State next;
   StateMatrix A;
   ControlMatrix B;
   for (int k = 0; k + 1 < n_; ++k) {
     problem_.dynamics(r.x[k], r.u[k], next, A, B);
-    worst = std::max(worst, (r.x[k + 1] - next).template lpNorm<Eigen::Infinity>());
+    worst = max_or_nan(worst, largest_magnitude(r.x[k + 1] - next));
   }
   return worst;
 }
@@ -364,6 +404,7 @@ int AltroSolver<Nx, Nu>::polish(Rollout& r) const {
     }
     for (int k = 0; k < n_; ++k) {
       const Constraints c = problem_.constraints(k, r.x[k], control(r, k));
+      check_rows(c, k, true);
       const bool has_control = k + 1 < n_;  // the last knot's du is ignored (problem.hpp)
       for (Eigen::Index i = 0; i < c.value.size(); ++i) {
         if (i >= c.equalities && c.value(i) <= 0.0 && lambda_[k](i) <= 0.0) continue;
@@ -413,9 +454,14 @@ AltroResult AltroSolver<Nx, Nu>::run(const Eigen::VectorXd& x0,
                                 ") are not its compile-time sizes (" + std::to_string(Nx) + ", " +
                                 std::to_string(Nu) + ")");
   }
-  if (n_ < 2 || x0.size() != nx || static_cast<int>(controls.size()) != n_ - 1) {
-    throw std::invalid_argument("trajopt: need x0 of size " + std::to_string(nx) + " and " +
-                                std::to_string(n_ - 1) + " initial controls");
+  if (n_ < 2) {
+    throw std::invalid_argument("trajopt: the problem has " + std::to_string(n_) +
+                                " knots; it needs at least 2");
+  }
+  if (x0.size() != nx || !x0.allFinite() || static_cast<int>(controls.size()) != n_ - 1) {
+    throw std::invalid_argument("trajopt: need x0 of " + std::to_string(nx) +
+                                " finite entries and " + std::to_string(n_ - 1) +
+                                " initial controls");
   }
   for (const Eigen::VectorXd& u : controls) {
     if (u.size() != nu || !u.allFinite()) {
@@ -432,8 +478,10 @@ AltroResult AltroSolver<Nx, Nu>::run(const Eigen::VectorXd& x0,
   d_.resize(n_ - 1);
   mu_ = settings_.penalty_initial;
   lambda_.resize(n_);
-  for (int k = 0; k < n_; ++k) {
-    lambda_[k] = Eigen::VectorXd::Zero(problem_.constraints(k, r.x[k], control(r, k)).value.size());
+  for (int k = 0; k < n_; ++k) {  // the first call fixes each knot's row count
+    const Constraints c = problem_.constraints(k, r.x[k], control(r, k));
+    lambda_[k] = Eigen::VectorXd::Zero(c.value.size());
+    check_rows(c, k, true);
   }
 
   AltroResult result;
@@ -441,12 +489,23 @@ AltroResult AltroSolver<Nx, Nu>::run(const Eigen::VectorXd& x0,
   for (int outer = 0; outer < settings_.max_outer_iterations; ++outer) {
     result.outer_iterations = outer + 1;
     double cost = augmented_cost(r);
+    // Only the initial guess can be non-finite here: the line search accepts finite costs and
+    // states only.
+    if (!std::isfinite(cost) || !finite_states(r)) {
+      result.status = AltroStatus::kNonFinite;
+      break;
+    }
     bool converged = false;
     for (int inner = 0;
          inner < settings_.max_inner_iterations && iterations_ < settings_.max_total_iterations;
          ++inner) {
       ++iterations_;
-      if (!backward_pass(r)) {
+      const Pass pass = backward_pass(r);
+      if (pass == Pass::kNonFinite) {
+        result.status = AltroStatus::kNonFinite;
+        break;
+      }
+      if (pass == Pass::kIndefinite) {
         if (!grow_regularization()) {
           result.status = AltroStatus::kRegularizationFailure;
           break;
@@ -454,13 +513,18 @@ AltroResult AltroSolver<Nx, Nu>::run(const Eigen::VectorXd& x0,
         continue;
       }
       // Converged when the predicted decrease, or the largest feedforward step, is negligible.
+      // The step is still taken if the line search accepts it: under a large penalty the Newton
+      // step that removes a small violation can be below gradient_tolerance relative to u, and
+      // skipping it left every multiplier update at the same point (an LQ problem with coupled
+      // equalities stalled for 30 outer iterations at a violation of 1e-5; test_trajopt).
       double step = 0.0;
       for (int k = 0; k + 1 < n_; ++k) {
         step = std::max(step, d_[k].template lpNorm<Eigen::Infinity>() /
-                                  (1.0 + r.u[k].template lpNorm<Eigen::Infinity>()));
+                                  (1.0 + r.u[k].template lpNorm<Eigen::Infinity>()));  // finite
       }
       if (-expected_linear_ < settings_.cost_tolerance * (1.0 + std::abs(cost)) ||
           step < settings_.gradient_tolerance) {
+        forward_pass(r, cost);  // a rejected step leaves r as it was
         converged = true;
         break;
       }
@@ -478,7 +542,7 @@ AltroResult AltroSolver<Nx, Nu>::run(const Eigen::VectorXd& x0,
         break;
       }
     }
-    if (result.status == AltroStatus::kRegularizationFailure) break;
+    if (result.status != AltroStatus::kMaxIterations) break;  // a failure ended the inner loop
     result.max_violation = max_violation(r);
     if (converged && result.max_violation <= settings_.constraint_tolerance) {
       result.status = AltroStatus::kSolved;

@@ -2,9 +2,10 @@
 // interface, for code written once against trajopt::Problem (the examples' Ipopt cross-check).
 // Every call copies its arguments into the fixed-size types and the answers back out; vectors of
 // the wrong size throw std::invalid_argument (require_size) instead of reaching the fixed-size
-// code. At the last knot the empty control becomes the zero control and du gets zero columns, as
-// problem.hpp's convention for each side says. The view holds a reference: the problem must
-// outlive it.
+// code. constraint_hessian's multipliers go to the problem as given, for it to check: their count
+// is its constraint rows, which only it knows. At the last knot the empty control becomes the zero
+// control and du gets zero columns, as problem.hpp's convention for each side says. The view holds
+// a reference: the problem must outlive it.
 #pragma once
 
 #include <Eigen/Core>

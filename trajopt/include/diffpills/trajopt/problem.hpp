@@ -13,10 +13,10 @@
 //
 // Sizes. ProblemOf<Nx, Nu> fixes n and m at compile time: states, controls, their Jacobians and
 // the cost expansions are then Eigen fixed-size types on the stack, and the solver's inner loops
-// (altro.hpp) allocate nothing for them. Problem = ProblemOf<Eigen::Dynamic, Eigen::Dynamic> takes
-// its sizes at run time (VectorXd, MatrixXd). A knot's constraint rows are a run-time count in
-// both. DynamicProblem<Nx, Nu> (dynamic_problem.hpp) shows a fixed-size problem as a dynamic one,
-// for code written against Problem (the examples' Ipopt cross-check).
+// (altro_solver.hpp) allocate nothing for them. Problem = ProblemOf<Eigen::Dynamic,
+// Eigen::Dynamic> takes its sizes at run time (VectorXd, MatrixXd). A knot's constraint rows are
+// a run-time count in both. DynamicProblem<Nx, Nu> (dynamic_problem.hpp) shows a fixed-size problem
+// as a dynamic one, for code written against Problem (the examples' Ipopt cross-check).
 //
 // The last knot has no control. A dynamic problem gets an empty u there and returns du with zero
 // columns; a fixed-size problem gets u = 0 there and its du, if it fills one, is ignored. Either
@@ -53,8 +53,6 @@ struct CostExpansionOf {
 template <int Nx, int Nu>
 class ProblemOf {
  public:
-  static constexpr int kStateSize = Nx;    // or Eigen::Dynamic
-  static constexpr int kControlSize = Nu;  // or Eigen::Dynamic
   using State = Eigen::Matrix<double, Nx, 1>;
   using Control = Eigen::Matrix<double, Nu, 1>;
   using StateMatrix = Eigen::Matrix<double, Nx, Nx>;    // A = df/dx
@@ -76,8 +74,10 @@ class ProblemOf {
   virtual Cost stage_cost(int k, const State& x, const Control& u) const = 0;
   virtual Cost terminal_cost(const State& x) const = 0;
 
-  // Constraints at knot k (k = N - 1: terminal, see above for u). The row count of a knot must
-  // not change between calls. The default has none.
+  // Constraints at knot k (k = N - 1: terminal, see above for u). A knot's row count is fixed by
+  // the first call and must stay the same in every later call, here and in constraint_values;
+  // dx and du have one row per value, and 0 <= equalities <= rows. The solver checks this at
+  // every call and throws std::invalid_argument naming the knot. The default has none.
   virtual Constraints constraints(int /*k*/, const State& x, const Control& u) const {
     Constraints none;
     none.value.resize(0);
