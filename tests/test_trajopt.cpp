@@ -272,7 +272,14 @@ TEST(Trajopt, CoupledEqualitiesMatchTheKktSolution) {
 // past: derivative rows that do not match the values (dx, or du at a stage knot, at either kind
 // of size), a row count that changes between calls or between constraints and
 // constraint_values, and an equality count outside [0, rows].
-enum class Flaw { kShortDx, kShortStageDu, kGrowingRows, kMoreValues, kTooManyEqualities };
+enum class Flaw {
+  kShortDx,
+  kShortStageDu,
+  kGrowingRows,
+  kMoreValues,
+  kTooManyEqualities,
+  kNegativeEqualities
+};
 
 template <int Nx, int Nu>
 class FlawedOf : public LinearQuadraticOf<Nx, Nu> {
@@ -296,7 +303,9 @@ class FlawedOf : public LinearQuadraticOf<Nx, Nu> {
     c.value = VectorXd::Constant(rows, -1.0);
     c.dx.setZero(flaw_ == Flaw::kShortDx ? rows - 1 : rows, x.size());
     c.du.setZero(flaw_ == Flaw::kShortStageDu && stage ? rows - 1 : rows, u.size());
-    c.equalities = flaw_ == Flaw::kTooManyEqualities ? 3 : 0;
+    c.equalities = flaw_ == Flaw::kTooManyEqualities    ? 3
+                   : flaw_ == Flaw::kNegativeEqualities ? -1
+                                                        : 0;
     return c;
   }
   Constraints constraint_values(int k, const State& x, const Control& u) const override {
@@ -311,33 +320,80 @@ class FlawedOf : public LinearQuadraticOf<Nx, Nu> {
 };
 
 template <int Nx, int Nu>
-void expect_refused(Flaw flaw, const std::string& prefix) {
+void expect_refused(Flaw flaw, const std::string& message) {
   const FlawedOf<Nx, Nu> problem(flaw);
   try {
     solve(problem, VectorXd::Ones(2), std::vector<VectorXd>(3, VectorXd::Zero(1)));
-    ADD_FAILURE() << prefix << ": no exception";
+    ADD_FAILURE() << message << ": no exception";
   } catch (const std::invalid_argument& error) {
-    EXPECT_EQ(std::string(error.what()).rfind(prefix, 0), 0u) << error.what();
+    EXPECT_EQ(error.what(), message);
   }
 }
 
 TEST(Trajopt, RefusesConstraintsThatBreakTheRowRules) {
-  expect_refused<Eigen::Dynamic, Eigen::Dynamic>(Flaw::kShortDx,
-                                                 "trajopt: constraints(0) returned 2 values");
-  expect_refused<2, 1>(Flaw::kShortDx, "trajopt: constraints(0) returned 2 values");
-  expect_refused<Eigen::Dynamic, Eigen::Dynamic>(Flaw::kShortStageDu,
-                                                 "trajopt: constraints(0) returned 2 values");
-  expect_refused<2, 1>(Flaw::kShortStageDu, "trajopt: constraints(0) returned 2 values");
-  expect_refused<2, 1>(Flaw::kGrowingRows, "trajopt: constraint_values(0) returned 3 values");
-  expect_refused<2, 1>(Flaw::kMoreValues, "trajopt: constraint_values(0) returned 5 values");
+  const std::string knot0 = "trajopt: constraints(0) returned 2 values ";
+  const std::string dx_short =
+      knot0 + "(0 equalities) with a 1 x 2 dx and a 2 x 1 du: dx must be 2 x 2";
+  const std::string du_short =
+      knot0 + "(0 equalities) with a 2 x 2 dx and a 1 x 1 du: du must be 2 x 1";
+  const std::string count = "(0 equalities): the knot has 2 rows, its first call's count";
+  expect_refused<Eigen::Dynamic, Eigen::Dynamic>(Flaw::kShortDx, dx_short);
+  expect_refused<2, 1>(Flaw::kShortDx, dx_short);
+  expect_refused<Eigen::Dynamic, Eigen::Dynamic>(Flaw::kShortStageDu, du_short);
+  expect_refused<2, 1>(Flaw::kShortStageDu, du_short);
+  expect_refused<2, 1>(Flaw::kGrowingRows,
+                       "trajopt: constraint_values(0) returned 3 values " + count);
+  expect_refused<2, 1>(Flaw::kMoreValues,
+                       "trajopt: constraint_values(0) returned 5 values " + count);
   expect_refused<Eigen::Dynamic, Eigen::Dynamic>(
-      Flaw::kTooManyEqualities, "trajopt: constraints(0) returned 2 values (3 equalities)");
+      Flaw::kTooManyEqualities,
+      knot0 + "(3 equalities) with a 2 x 2 dx and a 2 x 1 du: equalities must lie in [0, rows]");
+  expect_refused<2, 1>(
+      Flaw::kNegativeEqualities,
+      knot0 + "(-1 equalities) with a 2 x 2 dx and a 2 x 1 du: equalities must lie in [0, rows]");
+}
+
+// Settings out of range are refused by name, before any work.
+TEST(Trajopt, RefusesSettingsOutOfRange) {
+  const LinearQuadratic problem(MatrixXd::Identity(2, 2), MatrixXd::Identity(2, 1),
+                                MatrixXd::Identity(2, 2), MatrixXd::Identity(1, 1),
+                                MatrixXd::Identity(2, 2), 6);
+  const std::vector<VectorXd> guess(5, VectorXd::Zero(1));
+  const auto message = [&](const AltroSettings& settings) -> std::string {
+    try {
+      solve(problem, VectorXd::Ones(2), guess, settings);
+    } catch (const std::invalid_argument& error) {
+      return error.what();
+    }
+    return "no exception";
+  };
+  AltroSettings settings;
+  settings.penalty_initial = 0.0;
+  EXPECT_EQ(message(settings),
+            "trajopt: AltroSettings::penalty_initial must be finite and positive");
+  settings = {};
+  settings.regularization_initial = std::nan("");
+  EXPECT_EQ(message(settings),
+            "trajopt: AltroSettings::regularization_initial must be finite and positive");
+  settings = {};
+  settings.penalty_scaling = 0.5;
+  EXPECT_EQ(message(settings),
+            "trajopt: AltroSettings::penalty_scaling must be finite and at least 1");
+  settings = {};
+  settings.constraint_tolerance = std::nan("");
+  EXPECT_EQ(message(settings),
+            "trajopt: AltroSettings::constraint_tolerance must be zero or more (not NaN)");
+  settings = {};
+  settings.line_search_lower = 20.0;
+  EXPECT_EQ(message(settings),
+            "trajopt: AltroSettings::line_search_lower must be in [0, line_search_upper]");
+  EXPECT_EQ(solve(problem, VectorXd::Ones(2), guess).status, AltroStatus::kSolved);
 }
 
 // NaN or infinity from the problem ends the solve as kNonFinite, never as kSolved: before the
 // check, a NaN gradient gave NaN steps that std::max read as zero, "converged". A non-finite x0
 // is refused.
-enum class Poison { kNone, kGradient, kConstraintValue, kDynamics };
+enum class Poison { kNone, kGradient, kHessian, kConstraintValue, kDynamics, kSatisfiedMinusInf };
 
 class PoisonedLinearQuadratic : public LinearQuadratic {
  public:
@@ -349,12 +405,14 @@ class PoisonedLinearQuadratic : public LinearQuadratic {
   CostExpansion stage_cost(int k, const VectorXd& x, const VectorXd& u) const override {
     CostExpansion l = LinearQuadratic::stage_cost(k, x, u);
     if (poison_ == Poison::kGradient && k == 2) l.u(0) = std::nan("");
+    if (poison_ == Poison::kHessian && k == 2) l.uu(0, 0) = -HUGE_VAL;
     return l;
   }
   KnotConstraints constraints(int k, const VectorXd& x, const VectorXd& u) const override {
     KnotConstraints c;
     c.value = VectorXd::Constant(
         1, poison_ == Poison::kConstraintValue && k == 3 ? std::nan("") : x(0) - 10.0);
+    if (poison_ == Poison::kSatisfiedMinusInf && k == 3) c.value(0) = -HUGE_VAL;
     c.dx = MatrixXd::Zero(1, x.size());
     c.dx(0, 0) = 1.0;
     c.du = MatrixXd::Zero(1, u.size());
@@ -372,18 +430,28 @@ class PoisonedLinearQuadratic : public LinearQuadratic {
 
 TEST(Trajopt, NonFiniteProblemValuesAreNotSolved) {
   const std::vector<VectorXd> guess(5, VectorXd::Zero(1));
-  for (const Poison poison : {Poison::kGradient, Poison::kConstraintValue, Poison::kDynamics}) {
+  for (const Poison poison :
+       {Poison::kGradient, Poison::kHessian, Poison::kConstraintValue, Poison::kDynamics}) {
     const PoisonedLinearQuadratic problem(poison);
     const AltroResult result = solve(problem, VectorXd::Ones(2), guess);
     EXPECT_EQ(result.status, AltroStatus::kNonFinite)
         << static_cast<int>(poison) << ": " << to_string(result.status);
-    if (poison != Poison::kGradient) {  // NaN and infinite values are reported as such
+    // At once, without growing the regularization to its cap first (-inf made the factorization
+    // fail: 79 iterations before the check).
+    EXPECT_LE(result.iterations, 1) << static_cast<int>(poison);
+    if (poison == Poison::kConstraintValue || poison == Poison::kDynamics) {
       EXPECT_FALSE(std::isfinite(result.max_violation)) << static_cast<int>(poison);
     }
   }
-  // The same problem without poison solves: the status above comes from the NaN.
+  // The same problem without poison solves: the statuses above come from the NaN. So does one
+  // whose inequality is -inf, satisfied, at a knot: the row carries no weight and no multiplier
+  // and contributes nothing (0 * -inf would be NaN).
+  for (const Poison poison : {Poison::kNone, Poison::kSatisfiedMinusInf}) {
+    const AltroResult result = solve(PoisonedLinearQuadratic(poison), VectorXd::Ones(2), guess);
+    EXPECT_EQ(result.status, AltroStatus::kSolved) << static_cast<int>(poison);
+    EXPECT_LE(result.max_violation, 1e-6);
+  }
   const PoisonedLinearQuadratic clean(Poison::kNone);
-  EXPECT_EQ(solve(clean, VectorXd::Ones(2), guess).status, AltroStatus::kSolved);
   VectorXd x0 = VectorXd::Ones(2);
   x0(1) = std::nan("");
   EXPECT_THROW(solve(clean, x0, guess), std::invalid_argument);

@@ -49,8 +49,9 @@ enum class AltroStatus {
   kSolved,                 // max violation <= constraint_tolerance and the inner loop converged
   kMaxIterations,          // an iteration cap was reached first
   kRegularizationFailure,  // rho exceeded regularization_max
-  kNonFinite,  // the problem returned NaN or infinity: at the initial guess (a state or the cost)
-               // or in the derivatives of the backward pass
+  kNonFinite,  // NaN or infinity from the problem reached the accepted trajectory's cost, states
+               // or constraint values, or the backward pass's Q terms or gains (one met only in a
+               // line-search trial is rejected like any bad step)
 };
 
 const char* to_string(AltroStatus status);
@@ -68,7 +69,8 @@ struct AltroResult {
 
 // Solves from x0 with the controls as the initial guess (N - 1 of them; the states follow by
 // rollout). Throws std::invalid_argument on sizes that do not match the problem, a non-finite x0
-// or control, fewer than 2 knots, and constraints whose rows break problem.hpp's rules. A
+// or control, fewer than 2 knots, settings out of range (detail::check_settings), and constraints
+// whose rows break problem.hpp's rules. A
 // fixed-size problem (ProblemOf<5, 2>) runs the solver compiled for those sizes (altro_solver.hpp),
 // a dynamic one the solver compiled once in the library.
 template <int Nx, int Nu>

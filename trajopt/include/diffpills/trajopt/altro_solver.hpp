@@ -24,10 +24,13 @@
 namespace diffpills::trajopt::detail {
 
 // I_mu for one row: the penalty acts on equalities always, and on inequalities that are violated
-// or already carry a multiplier; a satisfied inequality with lambda = 0 contributes nothing.
+// or already carry a multiplier; a satisfied inequality with lambda = 0 contributes nothing. With
+// mu > 0 (check_settings), w = 0 exactly for those rows, and every sum over rows skips them: their
+// value need not even be finite (c = -inf is a satisfied inequality; 0 * c would be NaN). A NaN
+// value is weighted, so that it reaches the cost and the solve ends as kNonFinite.
 inline double penalty_weight(const Eigen::VectorXd& value, int equalities, Eigen::Index row,
                              double lambda, double mu) {
-  return (row < equalities || value(row) > 0.0 || lambda > 0.0) ? mu : 0.0;
+  return (row < equalities || !(value(row) <= 0.0) || lambda > 0.0) ? mu : 0.0;  // NaN: weighted
 }
 
 // max(a, b), but NaN if either is: std::max(0.0, NaN) is 0, which would let a problem that
@@ -48,6 +51,12 @@ template <class Vector>
 double largest_magnitude(const Vector& v) {
   return v.size() == 0 ? 0.0 : v.cwiseAbs().template maxCoeff<Eigen::PropagateNaN>();
 }
+
+// Throws std::invalid_argument naming the first setting that is NaN, or out of its range: the
+// penalties and regularizations finite and positive (a zero penalty would drop the multiplier
+// terms with the penalty's), their growth factors at least 1, the tolerances not negative, the
+// line search's bounds ordered. Iteration caps below 1 just stop the loops they cap.
+void check_settings(const AltroSettings& settings);
 
 template <int Nx, int Nu>
 class AltroSolver {
@@ -99,7 +108,7 @@ class AltroSolver {
   void add_terminal_constraints(const Constraints& c, Gradient& Vx, Hessian& Vxx) const;
   enum class Pass { kDone, kIndefinite, kNonFinite };
   Pass backward_pass(const Rollout& r);
-  bool forward_pass(Rollout& r, double& cost);
+  bool forward_pass(Rollout& r, double& cost, int steps);
   void update_multipliers(const Rollout& r);
   double total_violation(const Rollout& r) const;
   int polish(Rollout& r) const;
@@ -141,23 +150,30 @@ void AltroSolver<Nx, Nu>::check_rows(const Constraints& c, int k, bool derivativ
   const Eigen::Index rows = c.value.size();
   const bool has_control = k + 1 < n_;  // the last knot's du is ignored
   const Eigen::Index nx = problem_.state_size(), nu = problem_.control_size();
-  if (rows == lambda_[k].size() && c.equalities >= 0 && c.equalities <= rows &&
-      (!derivatives || (c.dx.rows() == rows && c.dx.cols() == nx &&
-                        (!has_control || (c.du.rows() == rows && c.du.cols() == nu))))) {
+  const auto shape = [](Eigen::Index r, Eigen::Index c) {
+    return std::to_string(r) + " x " + std::to_string(c);
+  };
+  std::string broken;
+  if (rows != lambda_[k].size()) {
+    broken = "the knot has " + std::to_string(lambda_[k].size()) + " rows, its first call's count";
+  } else if (c.equalities < 0 || c.equalities > rows) {
+    broken = "equalities must lie in [0, rows]";
+  } else if (derivatives && (c.dx.rows() != rows || c.dx.cols() != nx)) {
+    broken = "dx must be " + shape(rows, nx);
+  } else if (derivatives && has_control && (c.du.rows() != rows || c.du.cols() != nu)) {
+    broken = "du must be " + shape(rows, nu);
+  } else {
     return;
   }
-  const auto shape = [](const auto& m) {
-    return std::to_string(m.rows()) + " x " + std::to_string(m.cols());
-  };
   std::string what =
       "trajopt: " + std::string(derivatives ? "constraints(" : "constraint_values(") +
       std::to_string(k) + ") returned " + std::to_string(rows) + " values (" +
       std::to_string(c.equalities) + " equalities)";
-  if (derivatives) what += " with a " + shape(c.dx) + " dx and a " + shape(c.du) + " du";
-  what += "; knot " + std::to_string(k) + " has " + std::to_string(lambda_[k].size()) +
-          " rows, each derivative matrix one row per value, dx " + std::to_string(nx) + " columns" +
-          (has_control ? ", du " + std::to_string(nu) : std::string());
-  throw std::invalid_argument(what);
+  if (derivatives) {
+    what += " with a " + shape(c.dx.rows(), c.dx.cols()) + " dx and a " +
+            shape(c.du.rows(), c.du.cols()) + " du";
+  }
+  throw std::invalid_argument(what + ": " + broken);
 }
 
 template <int Nx, int Nu>
@@ -190,7 +206,7 @@ double AltroSolver<Nx, Nu>::augmented_cost(const Rollout& r) const {
     const Eigen::VectorXd& lambda = lambda_[k];
     for (Eigen::Index i = 0; i < c.value.size(); ++i) {
       const double w = penalty_weight(c.value, c.equalities, i, lambda(i), mu_);
-      cost += (lambda(i) + 0.5 * w * c.value(i)) * c.value(i);
+      if (w != 0.0) cost += (lambda(i) + 0.5 * w * c.value(i)) * c.value(i);
     }
   }
   return cost;
@@ -217,9 +233,10 @@ void AltroSolver<Nx, Nu>::add_terminal_constraints(const Constraints& c, Gradien
   const Eigen::VectorXd& lambda = lambda_[n_ - 1];
   for (Eigen::Index i = 0; i < c.value.size(); ++i) {
     const double w = penalty_weight(c.value, c.equalities, i, lambda(i), mu_);
+    if (w == 0.0) continue;
     const double g = lambda(i) + w * c.value(i);
-    if (g != 0.0) Vx.noalias() += g * c.dx.row(i).transpose();
-    if (w != 0.0) Vxx.noalias() += w * c.dx.row(i).transpose() * c.dx.row(i);
+    Vx.noalias() += g * c.dx.row(i).transpose();
+    Vxx.noalias() += w * c.dx.row(i).transpose() * c.dx.row(i);
   }
 }
 
@@ -233,10 +250,10 @@ void AltroSolver<Nx, Nu>::add_terminal_constraints(const Constraints& c, Gradien
 // The expected change for a step alpha d is alpha sum d'Qu + alpha^2 / 2 sum d'Quu d.
 // The constraint terms are summed row by row over the rows with a nonzero g or weight (see
 // add_terminal_constraints).
-// kIndefinite when Quu + rho I has no Cholesky factor (grow rho and retry). kNonFinite when a
-// gain is NaN or infinite: the problem returned one along the rollout (a NaN in V reaches every
-// earlier knot's Quu and Qu, and Eigen's LLT passes NaN through without failing), and no rho
-// repairs that.
+// kIndefinite when Quu + rho I has no Cholesky factor (grow rho and retry). kNonFinite when Quu,
+// Qu, Qux or a gain is NaN or infinite: the problem returned one along the rollout (a NaN in V
+// reaches every earlier knot's Quu and Qu, and Eigen's LLT passes NaN through without failing),
+// and no rho repairs that.
 template <int Nx, int Nu>
 typename AltroSolver<Nx, Nu>::Pass AltroSolver<Nx, Nu>::backward_pass(const Rollout& r) {
   const Cost terminal = problem_.terminal_cost(r.x[n_ - 1]);
@@ -269,17 +286,16 @@ typename AltroSolver<Nx, Nu>::Pass AltroSolver<Nx, Nu>::backward_pass(const Roll
     const Eigen::VectorXd& lambda = lambda_[k];
     for (Eigen::Index i = 0; i < c.value.size(); ++i) {
       const double w = penalty_weight(c.value, c.equalities, i, lambda(i), mu_);
+      if (w == 0.0) continue;
       const double g = lambda(i) + w * c.value(i);
-      if (g != 0.0) {
-        Qx.noalias() += g * c.dx.row(i).transpose();
-        Qu.noalias() += g * c.du.row(i).transpose();
-      }
-      if (w != 0.0) {
-        Qxx.noalias() += w * c.dx.row(i).transpose() * c.dx.row(i);
-        Quu.noalias() += w * c.du.row(i).transpose() * c.du.row(i);
-        Qux.noalias() += w * c.du.row(i).transpose() * c.dx.row(i);
-      }
+      Qx.noalias() += g * c.dx.row(i).transpose();
+      Qu.noalias() += g * c.du.row(i).transpose();
+      Qxx.noalias() += w * c.dx.row(i).transpose() * c.dx.row(i);
+      Quu.noalias() += w * c.du.row(i).transpose() * c.du.row(i);
+      Qux.noalias() += w * c.du.row(i).transpose() * c.dx.row(i);
     }
+    // An infinite entry would make the factorization fail and rho grow to its cap for nothing.
+    if (!Quu.allFinite() || !Qu.allFinite() || !Qux.allFinite()) return Pass::kNonFinite;
     ControlSquare regularized = Quu;
     regularized.diagonal().array() += rho_;
     const Eigen::LLT<ControlSquare> llt(regularized);
@@ -304,13 +320,14 @@ typename AltroSolver<Nx, Nu>::Pass AltroSolver<Nx, Nu>::backward_pass(const Roll
   return Pass::kDone;
 }
 
-// Backtracking from alpha = 1: u = ubar + K (x - xbar) + alpha d, accepted when the actual over
-// the expected decrease of the augmented cost lies in [line_search_lower, line_search_upper].
+// Backtracking from alpha = 1 over at most `steps` trials: u = ubar + K (x - xbar) + alpha d,
+// accepted when the actual over the expected decrease of the augmented cost lies in
+// [line_search_lower, line_search_upper].
 template <int Nx, int Nu>
-bool AltroSolver<Nx, Nu>::forward_pass(Rollout& r, double& cost) {
+bool AltroSolver<Nx, Nu>::forward_pass(Rollout& r, double& cost, int steps) {
   Rollout& candidate = candidate_;
   double alpha = 1.0;
-  for (int step = 0; step < settings_.line_search_steps; ++step, alpha *= 0.5) {
+  for (int step = 0; step < steps; ++step, alpha *= 0.5) {
     candidate.x[0] = x0_;
     for (int k = 0; k + 1 < n_; ++k) {
       candidate.u[k] = r.u[k] + alpha * d_[k];
@@ -446,6 +463,7 @@ int AltroSolver<Nx, Nu>::polish(Rollout& r) const {
 template <int Nx, int Nu>
 AltroResult AltroSolver<Nx, Nu>::run(const Eigen::VectorXd& x0,
                                      const std::vector<Eigen::VectorXd>& controls) {
+  check_settings(settings_);
   const int nx = problem_.state_size();
   const int nu = problem_.control_size();
   if ((Nx != Eigen::Dynamic && nx != Nx) || (Nu != Eigen::Dynamic && nu != Nu)) {
@@ -513,10 +531,14 @@ AltroResult AltroSolver<Nx, Nu>::run(const Eigen::VectorXd& x0,
         continue;
       }
       // Converged when the predicted decrease, or the largest feedforward step, is negligible.
-      // The step is still taken if the line search accepts it: under a large penalty the Newton
-      // step that removes a small violation can be below gradient_tolerance relative to u, and
-      // skipping it left every multiplier update at the same point (an LQ problem with coupled
-      // equalities stalled for 30 outer iterations at a violation of 1e-5; test_trajopt).
+      // If the constraints are not yet met, the full step is still tried once: under a large
+      // penalty the Newton step that removes a small violation can be below gradient_tolerance
+      // relative to u, and skipping it left every multiplier update at the same point (an LQ
+      // problem with coupled equalities stalled for 30 outer iterations at a violation of 1e-5;
+      // test_trajopt). Not when they are met: a step that lowers the augmented cost may raise the
+      // violation past the tolerance again. One trial only: near convergence the actual over the
+      // predicted decrease is rounding noise, and backtracking would roll out up to
+      // line_search_steps times for nothing.
       double step = 0.0;
       for (int k = 0; k + 1 < n_; ++k) {
         step = std::max(step, d_[k].template lpNorm<Eigen::Infinity>() /
@@ -524,12 +546,14 @@ AltroResult AltroSolver<Nx, Nu>::run(const Eigen::VectorXd& x0,
       }
       if (-expected_linear_ < settings_.cost_tolerance * (1.0 + std::abs(cost)) ||
           step < settings_.gradient_tolerance) {
-        forward_pass(r, cost);  // a rejected step leaves r as it was
+        if (max_violation(r) > settings_.constraint_tolerance) {
+          forward_pass(r, cost, 1);  // a rejected step leaves r as it was
+        }
         converged = true;
         break;
       }
       const double before = cost;
-      if (!forward_pass(r, cost)) {
+      if (!forward_pass(r, cost, settings_.line_search_steps)) {
         if (!grow_regularization()) {
           result.status = AltroStatus::kRegularizationFailure;
           break;
