@@ -20,19 +20,20 @@ namespace {
 Eigen::Vector3d lift(const Eigen::Vector2d& y) { return {y.x(), y.y(), 0.0}; }
 
 // What rules an edge pair out cheaply: two segments are at least |m1 - m2| - h1 - h2 apart (m the
-// midpoints, h the half-lengths), and an edge of B that does not cross A's plane is at least its
-// lower end's height above every point of A.
+// midpoints, h the half-lengths), and an edge of one polygon that does not cross the other's plane
+// is at least its lower end's height above every point of the other (B's edges over A's plane, and
+// in visit_all_pairs A's over B's, each a whole row of pairs).
 struct EdgeBound {
   Eigen::Vector3d middle;
   double half_length = 0.0;
   double height = 0.0;
 };
 
-EdgeBound edge_bound(const Segment& edge) {
-  const Eigen::Vector3d start = edge.at(-0.5 * edge.length), end = edge.at(0.5 * edge.length);
-  const bool crosses = (start.z() <= 0.0) != (end.z() <= 0.0) || start.z() == 0.0;
+// The bound of an edge whose ends are at heights z_start and z_end over the other polygon's plane.
+EdgeBound edge_bound(const Segment& edge, double z_start, double z_end) {
+  const bool crosses = (z_start <= 0.0) != (z_end <= 0.0) || z_start == 0.0;
   return {edge.middle, 0.5 * edge.length,
-          crosses ? 0.0 : std::min(std::abs(start.z()), std::abs(end.z()))};
+          crosses ? 0.0 : std::min(std::abs(z_start), std::abs(z_end))};
 }
 
 enum class Kind {
@@ -201,30 +202,45 @@ void offer_edge_pair(const Segment& edge, const EdgeBound& a_bound, Eigen::Index
   const double distance2 = (edge.at(closest.s_offset) - other.at(closest.t_offset)).squaredNorm();
   // Parallel edges overlap along intervals of the same length on both.
   const double half_width = closest.half_overlap * edge.length;
+  const double before = best.point.distance2;
   best.offer({distance2, Kind::kEdges, i, j, closest.s, closest.t, half_width, half_width},
              closest.overlap);
-  reach = std::sqrt(best.point.distance2) + tolerance;
+  if (best.point.distance2 < before)
+    reach = std::sqrt(best.point.distance2) + tolerance;  // else as it was
 }
 
 // Every vertex pair and edge pair, in index order: the small case, allocation-free.
 template <class Polygon>
 void visit_all_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
-                     const SmallBuffer<Segment>& b_edges, const SmallBuffer<EdgeBound>& b_bounds,
-                     double tolerance, Best& best) {
-  // The closest pair of vertices seeds the edge search with an achievable distance, so that the
-  // lower bounds rule most edge pairs out from the start.
-  for (Eigen::Index i = 0; i < a.size(); ++i) {
+                     const CarriedPolygon<Polygon>& X, const SmallBuffer<Segment>& b_edges,
+                     const SmallBuffer<EdgeBound>& b_bounds, double tolerance, Best& best) {
+  const Eigen::Index ka = a.size(), kb = W.size();
+  // The closest pair of vertices (the first in index order) seeds the edge search with an
+  // achievable distance, so that the lower bounds rule most edge pairs out from the start; offered
+  // once, not pair by pair (a 64-byte candidate copied at each improvement).
+  double seed = std::numeric_limits<double>::infinity();
+  Eigen::Index a_vertex = 0, b_vertex = 0;
+  for (Eigen::Index i = 0; i < ka; ++i) {
     const Eigen::Vector3d vertex = lift(a.vertex(i));
-    for (Eigen::Index j = 0; j < W.size(); ++j) {
-      best.offer({(vertex - W[j]).squaredNorm(), Kind::kEdges, i, j, 1.0, 1.0}, false);
+    for (Eigen::Index j = 0; j < kb; ++j) {
+      const double distance2 = (vertex - W[j]).squaredNorm();
+      if (distance2 < seed) seed = distance2, a_vertex = i, b_vertex = j;
     }
   }
+  best.offer({seed, Kind::kEdges, a_vertex, b_vertex, 1.0, 1.0}, false);
   double reach = std::sqrt(best.point.distance2) + tolerance;
-  for (Eigen::Index i = 0; i < a.size(); ++i) {
-    const Segment edge = a.edge(i);
-    const EdgeBound a_bound = edge_bound(edge);
-    for (Eigen::Index j = 0; j < W.size(); ++j) {
-      offer_edge_pair(edge, a_bound, i, b_edges[j], b_bounds[j], j, tolerance, reach, best);
+  // A's edges with their heights over B's plane (X: A's vertices in B's frame).
+  SmallBuffer<Segment> a_edges(ka);
+  SmallBuffer<EdgeBound> a_bounds(ka);
+  for (Eigen::Index i = 0; i < ka; ++i) {
+    a_edges[i] = a.edge(i);
+    a_bounds[i] = edge_bound(a_edges[i], X.start(i).z(), X.end(i).z());
+  }
+  for (Eigen::Index i = 0; i < ka; ++i) {
+    if (a_bounds[i].height >= reach) continue;  // the whole row
+    for (Eigen::Index j = 0; j < kb; ++j) {
+      offer_edge_pair(a_edges[i], a_bounds[i], i, b_edges[j], b_bounds[j], j, tolerance, reach,
+                      best);
     }
   }
 }
@@ -312,7 +328,7 @@ void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
   double reach = std::sqrt(best.point.distance2) + tolerance;
   for (Eigen::Index i = 0; i < a.size(); ++i) {
     const Segment edge = a.edge(i);
-    const EdgeBound a_bound = edge_bound(edge);
+    const EdgeBound a_bound = edge_bound(edge, 0.0, 0.0);  // its height is not used here
     for (const Eigen::Index j : long_edges) {
       offer_edge_pair(edge, a_bound, i, b_edges[j], b_bounds[j], j, tolerance, reach, best);
     }
@@ -344,14 +360,14 @@ std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
   for (Eigen::Index j = 0; j < kb; ++j) {
     const Segment edge = b.edge(j);
     b_edges[j] = {0.5 * (W.start(j) + W.end(j)), frame.b_in_a * edge.direction, edge.length};
-    b_bounds[j] = edge_bound(b_edges[j]);
+    b_bounds[j] = edge_bound(b_edges[j], W.start(j).z(), W.end(j).z());
   }
   // Whole polygons (PolygonView) always get every pair: the fast path sends only small ones here,
   // and the tests compare the windows with this full enumeration.
   if (std::is_same_v<Polygon, SubPolygon> && a.size() * kb > kSweepLimit) {
     sweep_pairs(a, W, b_edges, b_bounds, tolerance, best);
   } else {
-    visit_all_pairs(a, W, b_edges, b_bounds, tolerance, best);
+    visit_all_pairs(a, W, X, b_edges, b_bounds, tolerance, best);
   }
   const auto sides_of = [&](const Candidate& c) { return sides(c, a, b, W, X); };
   return sides(best.choice(tolerance, tie_tolerance, sides_of), a, b, W, X);
