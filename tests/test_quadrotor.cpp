@@ -79,6 +79,34 @@ TEST(Quadrotor, StepJacobiansMatchCentralDifferences) {
   std::cout << "[quadrotor] step Jacobians vs central differences: max error " << worst << "\n";
 }
 
+// The step multiplies Fx only through its known nonzero blocks (SparseStateProduct in
+// quadrotor.cpp): at random states every other entry of Fx is exactly zero, and the position rows
+// are exactly the identity on the velocity.
+TEST(Quadrotor, StateJacobianIsZeroOutsideTheBlocksTheStepMultiplies) {
+  const Quadrotor model;
+  std::mt19937_64 rng(22);
+  Eigen::Matrix<bool, 13, 13> read = Eigen::Matrix<bool, 13, 13>::Constant(false);
+  read.block<3, 3>(0, 7).setConstant(true);
+  read.block<4, 4>(3, 3).setConstant(true);
+  read.block<4, 3>(3, 10).setConstant(true);
+  read.block<3, 4>(7, 3).setConstant(true);
+  read.block<3, 3>(10, 10).setConstant(true);
+  for (int trial = 0; trial < 100; ++trial) {
+    State xdot;
+    Quadrotor::StateMatrix Fx;
+    Quadrotor::ControlMatrix Fu;
+    model.derivative(random_state(rng), random_thrusts(rng), xdot, Fx, Fu);
+    for (int i = 0; i < 13; ++i) {
+      for (int j = 0; j < 13; ++j) {
+        if (!read(i, j)) {
+          EXPECT_EQ(Fx(i, j), 0.0) << "Fx(" << i << ", " << j << ")";
+        }
+      }
+    }
+    EXPECT_TRUE((Fx.block<3, 3>(0, 7).array() == Eigen::Matrix3d::Identity().array()).all());
+  }
+}
+
 // Physics: level hover thrust balances gravity; rolled about +x, the thrust pushes towards -y;
 // more thrust on the +y rotor than on the -y rotor spins the body about +x, on the -x rotor than
 // the +x rotor about +y; rotors 1 and 3 (spinning one way) against 2 and 4 yaw it about +z.

@@ -86,6 +86,17 @@ MatrixXd random_matrix(std::mt19937_64& rng, int rows, int cols) {
   return m;
 }
 
+// A random discrete linear system x' = A x + B u: A near the identity, B small.
+struct LinearSystem {
+  MatrixXd A, B;
+};
+LinearSystem random_system(std::mt19937_64& rng, int n, int m) {
+  LinearSystem system;  // A's entries drawn before B's
+  system.A = MatrixXd::Identity(n, n) + 0.1 * random_matrix(rng, n, n);
+  system.B = 0.1 * random_matrix(rng, n, m);
+  return system;
+}
+
 // ALTRO on random LQ problems (4 states, 2 controls) against the Riccati recursion, written out
 // here; Nx, Nu pick the solver's sizes, fixed or run-time.
 template <int Nx, int Nu>
@@ -93,8 +104,7 @@ void expect_riccati_controls(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
     const int n = 4, m = 2, N = 30;
-    const MatrixXd A = MatrixXd::Identity(n, n) + 0.1 * random_matrix(rng, n, n);
-    const MatrixXd B = 0.1 * random_matrix(rng, n, m);
+    const auto [A, B] = random_system(rng, n, m);
     const MatrixXd L = random_matrix(rng, n, n);
     const MatrixXd Q = L.transpose() * L + MatrixXd::Identity(n, n);
     const MatrixXd R = MatrixXd::Identity(m, m) * 0.5;
@@ -240,8 +250,7 @@ void expect_coupled_qp_controls(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   for (int trial = 0; trial < 10; ++trial) {
     const int n = 4, m = 2, N = 20;
-    const MatrixXd A = MatrixXd::Identity(n, n) + 0.1 * random_matrix(rng, n, n);
-    const MatrixXd B = 0.1 * random_matrix(rng, n, m);
+    const auto [A, B] = random_system(rng, n, m);
     const MatrixXd Q = MatrixXd::Identity(n, n);
     const MatrixXd R = 0.5 * MatrixXd::Identity(m, m);
     const MatrixXd Qf = 10.0 * Q;
@@ -270,16 +279,8 @@ TEST(Trajopt, CoupledEqualitiesMatchTheKktSolution) {
 
 // A problem whose constraints break problem.hpp's rules is refused by name instead of being read
 // past: derivative rows that do not match the values (dx, or du at a stage knot, at either kind
-// of size), a row count that changes between calls or between constraints and
-// constraint_values, and an equality count outside [0, rows].
-enum class Flaw {
-  kShortDx,
-  kShortStageDu,
-  kGrowingRows,
-  kMoreValues,
-  kTooManyEqualities,
-  kNegativeEqualities
-};
+// of size), a row count that changes between calls, and an equality count outside [0, rows].
+enum class Flaw { kShortDx, kShortStageDu, kGrowingRows, kTooManyEqualities, kNegativeEqualities };
 
 template <int Nx, int Nu>
 class FlawedOf : public LinearQuadraticOf<Nx, Nu> {
@@ -308,11 +309,6 @@ class FlawedOf : public LinearQuadraticOf<Nx, Nu> {
                                                         : 0;
     return c;
   }
-  Constraints constraint_values(int k, const State& x, const Control& u) const override {
-    Constraints c = constraints(k, x, u);
-    if (flaw_ == Flaw::kMoreValues) c.value = VectorXd::Constant(5, -1.0);
-    return c;
-  }
 
  private:
   Flaw flaw_;
@@ -336,21 +332,50 @@ TEST(Trajopt, RefusesConstraintsThatBreakTheRowRules) {
       knot0 + "(0 equalities) with a 1 x 2 dx and a 2 x 1 du: dx must be 2 x 2";
   const std::string du_short =
       knot0 + "(0 equalities) with a 2 x 2 dx and a 1 x 1 du: du must be 2 x 1";
-  const std::string count = "(0 equalities): the knot has 2 rows, its first call's count";
   expect_refused<Eigen::Dynamic, Eigen::Dynamic>(Flaw::kShortDx, dx_short);
   expect_refused<2, 1>(Flaw::kShortDx, dx_short);
   expect_refused<Eigen::Dynamic, Eigen::Dynamic>(Flaw::kShortStageDu, du_short);
   expect_refused<2, 1>(Flaw::kShortStageDu, du_short);
   expect_refused<2, 1>(Flaw::kGrowingRows,
-                       "trajopt: constraint_values(0) returned 3 values " + count);
-  expect_refused<2, 1>(Flaw::kMoreValues,
-                       "trajopt: constraint_values(0) returned 5 values " + count);
+                       "trajopt: constraints(0) returned 3 values (0 equalities) with a 3 x 2 dx "
+                       "and a 3 x 1 du: the knot has 2 rows, its first call's count");
   expect_refused<Eigen::Dynamic, Eigen::Dynamic>(
       Flaw::kTooManyEqualities,
       knot0 + "(3 equalities) with a 2 x 2 dx and a 2 x 1 du: equalities must lie in [0, rows]");
   expect_refused<2, 1>(
       Flaw::kNegativeEqualities,
       knot0 + "(-1 equalities) with a 2 x 2 dx and a 2 x 1 du: equalities must lie in [0, rows]");
+}
+
+// constraint_values is read where no derivatives follow: the polish's trial steps (the line search
+// evaluates constraints). Values with more rows than the knot's are refused there too.
+class CarBusWithExtraValues : public examples::CarBusProblem {
+ public:
+  using CarBusProblem::CarBusProblem;
+  Constraints constraint_values(int k, const State& x, const Control& u) const override {
+    Constraints c = CarBusProblem::constraint_values(k, x, u);
+    c.value.conservativeResize(c.value.size() + 3);
+    c.value.tail(3).setConstant(-1.0);
+    return c;
+  }
+};
+
+TEST(Trajopt, RefusesExtraConstraintValuesInThePolish) {
+  const CarBusWithExtraValues problem{examples::CarBusScenario{}};
+  const examples::CarBusScenario& s = problem.scenario();
+  const auto c = problem.constraints(0, s.x0, examples::CarBusProblem::Control::Zero());
+  const std::string rows = std::to_string(c.value.size());
+  AltroSettings loose;  // stops with a violation left for the polish (see the polish test)
+  loose.constraint_tolerance = 1e-3;
+  try {
+    solve(problem, s.x0, problem.straight_line_controls(), loose);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(error.what(), "trajopt: constraint_values(0) returned " +
+                                std::to_string(c.value.size() + 3) + " values (" +
+                                std::to_string(c.equalities) + " equalities): the knot has " +
+                                rows + " rows, its first call's count");
+  }
 }
 
 // Settings out of range are refused by name, before any work.

@@ -33,6 +33,27 @@ Eigen::Matrix<double, 3, 4> body_z_jacobian(double s, double qx, double qy, doub
   return dbody_z_dq;
 }
 
+// Fx S for the state Jacobian Fx of Quadrotor::derivative, whose nonzeros lie in four row blocks
+// (the derivation below it): position rows 0-2 are the identity on the velocity (columns 7-9);
+// attitude rows 3-6 depend on q and w (columns 3-6, 10-12); velocity rows 7-9 on q (3-6); rate
+// rows 10-12 on w (10-12). 833 multiplications per 13 x 17 stage Jacobian instead of 2,873.
+struct SparseStateProduct {
+  template <int Cols>
+  Eigen::Matrix<double, 13, Cols> operator()(const Quadrotor::StateMatrix& Fx,
+                                             const Eigen::Matrix<double, 13, Cols>& S) const {
+    Eigen::Matrix<double, 13, Cols> product;
+    product.template middleRows<3>(0) = S.template middleRows<3>(7);
+    product.template middleRows<4>(3).noalias() =
+        Fx.block<4, 4>(3, 3) * S.template middleRows<4>(3) +
+        Fx.block<4, 3>(3, 10) * S.template middleRows<3>(10);
+    product.template middleRows<3>(7).noalias() =
+        Fx.block<3, 4>(7, 3) * S.template middleRows<4>(3);
+    product.template middleRows<3>(10).noalias() =
+        Fx.block<3, 3>(10, 10) * S.template middleRows<3>(10);
+    return product;
+  }
+};
+
 }  // namespace
 
 // Jacobians, with q = [s, e] (scalar, vector part):
@@ -78,7 +99,7 @@ void Quadrotor::step(double h, const State& x, const Control& u, State& next, St
                      ControlMatrix& B) const {
   rk4_step<13, 4>([this](const State& s, const Control& c, State& sdot, StateMatrix& Fx,
                          ControlMatrix& Fu) { derivative(s, c, sdot, Fx, Fu); },
-                  h, x, u, next, A, B);
+                  h, x, u, next, A, B, SparseStateProduct{});
   const double norm = next.segment<4>(3).norm();
   const Eigen::Vector4d unit = next.segment<4>(3) / norm;
   const Eigen::Matrix4d projection = (Eigen::Matrix4d::Identity() - unit * unit.transpose()) / norm;

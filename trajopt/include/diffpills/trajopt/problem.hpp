@@ -86,10 +86,11 @@ class ProblemOf {
     return none;
   }
 
-  // Values only, for the line search and the multiplier updates, which need no derivatives.
-  // The defaults call the full evaluations; a problem overrides them when that saves work
-  // (measured on the car-bus problem: the line search's derivative evaluations were a fifth of
-  // the solve).
+  // Values only, where no derivatives are needed: the cost's values in the line search, the
+  // constraint values in the polish's trial steps and in the Ipopt bridge's constraint function.
+  // The defaults call the full evaluations; a problem overrides them when that saves work. (The
+  // line search evaluates constraints() with derivatives, which ALTRO keeps for the backward pass
+  // at the rollout it accepts: see AltroSolver::constraints_at.)
   virtual double stage_cost_value(int k, const State& x, const Control& u) const {
     return stage_cost(k, x, u).value;
   }

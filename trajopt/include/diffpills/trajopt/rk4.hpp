@@ -25,11 +25,23 @@
 
 namespace diffpills::trajopt {
 
+// Fx times a stage's Jacobian (N x N or N x M), for any Fx.
+struct DenseProduct {
+  template <class Jacobian, class Stage>
+  auto operator()(const Jacobian& Fx, const Stage& stage) const {
+    return (Fx * stage).eval();
+  }
+};
+
 // derivative(x, u, xdot, Fx, Fu) evaluates F and its Jacobians Fx (N x N), Fu (N x M).
-template <int N, int M, class Derivative>
+// product(Fx, S) returns Fx S for the stages' Jacobians S: the three stages after the first cost
+// an N x N x (N + M) product each, and a model whose Fx has known zeros can skip them (the
+// quadrotor's has 52 nonzeros of 169).
+template <int N, int M, class Derivative, class Product = DenseProduct>
 void rk4_step(const Derivative& derivative, double h, const Eigen::Matrix<double, N, 1>& x,
               const Eigen::Matrix<double, M, 1>& u, Eigen::Matrix<double, N, 1>& next,
-              Eigen::Matrix<double, N, N>& A, Eigen::Matrix<double, N, M>& B) {
+              Eigen::Matrix<double, N, N>& A, Eigen::Matrix<double, N, M>& B,
+              const Product& product = {}) {
   using Vector = Eigen::Matrix<double, N, 1>;
   using StateMatrix = Eigen::Matrix<double, N, N>;
   using ControlMatrix = Eigen::Matrix<double, N, M>;
@@ -50,8 +62,8 @@ void rk4_step(const Derivative& derivative, double h, const Eigen::Matrix<double
     derivative(stage, u, k, Fx, Fu);
     // The first stage is x itself (stage_x = I, stage_u = 0): its products are Fx and Fu exactly,
     // and skipping them saves a quarter of the n x n x n products (the quadrotor: n = 13).
-    const StateMatrix kx = i == 0 ? Fx : StateMatrix(Fx * stage_x);
-    const ControlMatrix ku = i == 0 ? Fu : ControlMatrix(Fx * stage_u + Fu);
+    const StateMatrix kx = i == 0 ? Fx : StateMatrix(product(Fx, stage_x));
+    const ControlMatrix ku = i == 0 ? Fu : ControlMatrix(product(Fx, stage_u) + Fu);
     next += weights[i] * k;
     A += weights[i] * kx;
     B += weights[i] * ku;
