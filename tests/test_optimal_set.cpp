@@ -152,6 +152,31 @@ TEST(OptimalSet, ParallelEdgesOfSlightlyTurnedHexagonsBothOrders) {
   EXPECT_LE((swap_halves(ba.gradient) - ab.gradient).norm(), 1e-9);
 }
 
+// A regular many-sided polygon over a larger one, its plane turned a few 1e-12 rad about x (past
+// the 1e-12 of parallel planes) so that its lowest vertex points down the slope: both edges at
+// that vertex are within 1e-12 of parallel to the face below, and the vertex is the one closest
+// point. The edges' intervals tie with it within the tolerance only; which one won depended on
+// rounding and so on the order of the shapes (a hostile review, a 133-gon and a 129-gon: points
+// 0.015 apart). 16 sides: the enumeration of every pair; 128: the windows.
+TEST(OptimalSet, ManySidedPolygonAFewPicoradiansFromParallel) {
+  for (const auto& [sides, tilt] : {std::pair{16, 3e-12}, std::pair{128, 6e-12}}) {
+    SCOPED_TRACE(sides);
+    Eigen::MatrixX2d C(sides, 2);  // rows between the vertices, a vertex at -90 degrees
+    for (int k = 0; k < sides; ++k) {
+      const double angle = 2 * M_PI * (k + 0.5) / sides;
+      C.row(k) << std::cos(angle), std::sin(angle);
+    }
+    const PaddedPolygon floor(C, Eigen::VectorXd::Constant(sides, 1.0), 0.05);
+    const PaddedPolygon plate(C, Eigen::VectorXd::Constant(sides, 0.5), 0.05);
+    const double vertex = 0.5 / std::cos(M_PI / sides);  // the circumradius
+    const Eigen::Vector3d centre(0.1, 0.2, 0.3);
+    const Pose turned(centre, about(tilt, 1, 0, 0));
+    const Eigen::Vector3d lowest =
+        centre + Eigen::Vector3d(0, -vertex * std::cos(tilt), -vertex * std::sin(tilt));
+    expect_middle(floor, Pose(), plate, turned, {lowest.x(), lowest.y(), 0}, lowest);
+  }
+}
+
 // A box face (a square in a vertical plane) standing on a table: its bottom edge x in [-0.4, 0.6]
 // meets the table x in [-0.5, 0.5]; raised by 0.1 it hovers over the same interval; a wider box
 // hangs over both sides of the table.
