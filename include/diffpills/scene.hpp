@@ -26,13 +26,13 @@
 // query.
 //
 // Broadphase. Each query bounds every primitive by its world box (the padded core's, grown by half
-// the margin when it is positive: two padded shapes within the margin have boxes that overlap so),
-// builds bounding-volume hierarchies over the boxes (linear BVHs: Morton codes of the centres,
-// radix-sorted, split as an octree), one per body and one over the bodies' bounds, and walks them
-// for the overlapping pairs of bodies checked against each other: about O(n log n) for n
-// primitives at a fixed density, plus the pairs found; the primitives of one body, or of two
-// bodies never checked against each other, are never walked against each other. Only the pairs
-// found get the narrowphase. (bench_scene: at 10^4 bodies about as fast as FCL's
+// the margin when it is positive: two padded shapes within the margin have boxes that overlap so).
+// Up to 128 primitives it tests every pair of boxes; above, it builds bounding-volume hierarchies
+// over the boxes (linear BVHs: Morton codes of the centres, radix-sorted, split as an octree), one
+// per body and one over the bodies' bounds, and walks them for the overlapping pairs of bodies
+// checked against each other: about O(n log n) for n primitives at a fixed density, plus the pairs
+// found; the primitives of one body, or of two bodies never checked against each other, are never
+// walked against each other. Only the pairs found get the narrowphase. (bench_scene: at 10^4 bodies about as fast as FCL's
 // DynamicAABBTreeCollisionManager refitting and walking its tree on the same scene, which reports
 // five times the pairs, BENCHMARKS.md.)
 //

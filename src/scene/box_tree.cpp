@@ -251,11 +251,42 @@ Box merged(const Box& a, const Box& b) { return {a.low.cwiseMin(b.low), a.high.c
 // their own trees walked against each other, each box pair then filtered exactly. So the boxes of
 // one group, or of groups that are never checked against each other (an excluded pair of bodies,
 // categories that never meet), cost nothing beyond their trees, however much they overlap.
-std::vector<std::pair<int, int>> overlapping_pairs(
+namespace {
+
+// Up to this many boxes every pair is tested directly, the filters first: sorting, two levels of
+// trees and their walk cost more than n (n - 1) / 2 box tests. Measured on random boxes in groups
+// of two, 8 to 128 boxes: 3-10x faster where most boxes overlap (43 ns against 439 at 8 boxes,
+// 8.9 us against 31 at 128), 3-16x where few do (6.1 us against 17.5 at 128). The trees win from a
+// few hundred boxes on; bench_scene's smallest scene (100 bodies, ~200 boxes) keeps them.
+constexpr std::size_t kDirectUpTo = 128;
+
+std::vector<std::pair<int, int>> every_pair_tested(
     const std::vector<Box>& boxes, const std::vector<BoxFilter>& filters,
     const std::function<bool(int, int)>& groups_checked) {
   std::vector<std::pair<int, int>> pairs;
-  if (boxes.empty()) return pairs;
+  const int n = static_cast<int>(boxes.size());
+  for (int i = 0; i < n; ++i) {
+    const BoxFilter& f = filters[static_cast<std::size_t>(i)];
+    const Box& a = boxes[static_cast<std::size_t>(i)];
+    for (int j = i + 1; j < n; ++j) {
+      const BoxFilter& g = filters[static_cast<std::size_t>(j)];
+      if (f.group == g.group || (f.category & g.mask) == 0 || (g.category & f.mask) == 0 ||
+          !overlap(a, boxes[static_cast<std::size_t>(j)]) || !groups_checked(f.group, g.group)) {
+        continue;
+      }
+      pairs.emplace_back(i, j);
+    }
+  }
+  return pairs;
+}
+
+}  // namespace
+
+std::vector<std::pair<int, int>> overlapping_pairs(
+    const std::vector<Box>& boxes, const std::vector<BoxFilter>& filters,
+    const std::function<bool(int, int)>& groups_checked) {
+  if (boxes.size() <= kDirectUpTo) return every_pair_tested(boxes, filters, groups_checked);
+  std::vector<std::pair<int, int>> pairs;
   std::vector<int> by_group(boxes.size());
   std::iota(by_group.begin(), by_group.end(), 0);
   const auto group_of = [&](int i) { return filters[static_cast<std::size_t>(i)].group; };
