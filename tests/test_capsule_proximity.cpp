@@ -39,8 +39,8 @@ double scene_size(const Pair& p) {
 }
 
 bool generic(const Pair& p) {
-  Proximity unused;
-  return detail::generic_capsule_proximity(p.a, p.pose_a, p.b, p.pose_b, unused);
+  detail::GenericCapsuleSolution unused;
+  return detail::solve_generic_capsules(p.a, p.pose_a, p.b, p.pose_b, unused);
 }
 
 Proximity fused(const Pair& p) { return proximity(p.a, p.pose_a, p.b, p.pose_b); }

@@ -62,7 +62,7 @@ inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3
 //   s = clamp(-((w x v) . n) / |n|^2, -h, h), n = u x v;  t = f + s cos, f = v . w, cos = u . v;
 //   if t leaves [-k, k]: t = clamp(t, -k, k), s = clamp(t cos - c, -h, h), c = u . w.
 // False outside the generic case (capsule_proximity.hpp). Forced inline into proximity()'s pass,
-// as fill_proximity: as calls, with the solution passed through memory, proximity() took 5 ns
+// as generic_proximity: as calls, with the solution passed through memory, proximity() took 5 ns
 // (10%) longer. The Jacobian and the Hessian get it through memory (solve_generic_capsules), a
 // cost they carry easily.
 [[gnu::always_inline]] inline bool solve_generic(const Capsule& a, const Pose& pose_a,
@@ -124,34 +124,36 @@ inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3
 // s, t optimal) dphi/dr_a = 2 D scale = -dphi/dr_b, and the quaternion parts are
 // 2 D . dP/dq_a = axis_gradient(q_a, s 2 D) and -axis_gradient(q_b, t 2 D), times scale^2
 // (pair_result.cpp's restore_units). The normal points from a to b: -D / |D|.
-[[gnu::always_inline]] inline void fill_proximity(const GenericCapsuleSolution& g, const Capsule& a,
-                                                  const Pose& pose_a, const Capsule& b,
-                                                  const Pose& pose_b, Proximity& result) {
+[[gnu::always_inline]] inline Proximity generic_proximity(const GenericCapsuleSolution& g,
+                                                          const Capsule& a, const Pose& pose_a,
+                                                          const Capsule& b, const Pose& pose_b) {
   const double scale = g.scale;
   const double radius_sum = a.radius() + b.radius();
-  result.phi = g.D2 * scale * scale - radius_sum * radius_sum;
   const Eigen::Vector3d slope = 2.0 * g.D;  // dphi/dD in the frame
-  result.gradient.segment<3>(0) = slope * scale;
+  Eigen::Matrix<double, 14, 1> gradient;
+  gradient.segment<3>(0) = slope * scale;
   // Two products, not scale^2: that loses bits below 2^-511 (a subnormal) and is zero below
   // 2^-537, where the gradient is neither.
-  result.gradient.segment<4>(3) = axis_gradient(g.attitude_a, g.s * slope) * scale * scale;
-  result.gradient.segment<3>(7) = -slope * scale;
-  result.gradient.segment<4>(10) = -axis_gradient(g.attitude_b, g.t * slope) * scale * scale;
+  gradient.segment<4>(3) = axis_gradient(g.attitude_a, g.s * slope) * scale * scale;
+  gradient.segment<3>(7) = -slope * scale;
+  gradient.segment<4>(10) = -axis_gradient(g.attitude_b, g.t * slope) * scale * scale;
   // The normal by contact_normal.hpp's rule, as the general pipeline takes it: both points
   // inside their segments, D is normal to both axes and the normal is -+(u x v) / |u x v|, exact
   // to ~eps / sin, where D / |D| carries s's rounding, ~eps |w| / (sin^2 |D|) (up to 2e-13 at
   // sin^2 = 1e-2 and |D| = 1e-2: a hostile review measured 1.7e-13); taken where that is the
   // smaller error, sin >= |D|. Otherwise D is exact to a few eps S and D / |D| to eps S / |D|.
-  if (g.edge_normal) {
-    result.normal = g.n * ((g.n.dot(g.D) > 0.0 ? -1.0 : 1.0) / std::sqrt(g.sin2));
-  } else {
-    result.normal = g.D * (-1.0 / std::sqrt(g.D2));
-  }
-  result.cores_intersect = false;
-  result.core_points = {pose_a.r() + scale * (g.s * g.attitude_a.axis),
-                        pose_b.r() + scale * (g.t * g.attitude_b.axis)};
-  result.points = {result.core_points[0] + a.radius() * result.normal,
-                   result.core_points[1] - b.radius() * result.normal};  // eqs. caps_c_1, caps_c_2
+  const Eigen::Vector3d normal =
+      g.edge_normal ? Eigen::Vector3d(g.n * ((g.n.dot(g.D) > 0.0 ? -1.0 : 1.0) / std::sqrt(g.sin2)))
+                    : Eigen::Vector3d(g.D * (-1.0 / std::sqrt(g.D2)));
+  const Eigen::Vector3d core_a = pose_a.r() + scale * (g.s * g.attitude_a.axis);
+  const Eigen::Vector3d core_b = pose_b.r() + scale * (g.t * g.attitude_b.axis);
+  // Every member given: the default member initializers (a zeroed gradient) are not run first.
+  return {g.D2 * scale * scale - radius_sum * radius_sum,
+          {core_a, core_b},
+          {core_a + a.radius() * normal, core_b - b.radius() * normal},  // eqs. caps_c_1, caps_c_2
+          normal,
+          false,
+          gradient};
 }
 
 // du/dq for the unit axis u = Q(q^) e_x of the q as given: J(q^) (I - q^ q^') / |q|, with J's
@@ -264,7 +266,7 @@ inline Eigen::Matrix<double, 6, 14> point_columns(const Eigen::Matrix<double, 6,
 // The closest points' Jacobians over y in the frame. With s, t held, p1 moves by s Ju along q_a,
 // p2 by t Jv along q_b; the free coordinates add u ds and v dt. The surface points p1 + R_a n,
 // p2 - R_b n move with the normal too:
-//   the edges' normal n = sign (u x v) / |u x v| (fill_proximity): dn = sign (I - n n')
+//   the edges' normal n = sign (u x v) / |u x v| (generic_proximity): dn = sign (I - n n')
 //     [0, -[v]x Ju, [u]x Jv] / |u x v|, exactly zero along the positions (from
 //     (I - n n') (dp2 - dp1) / |Delta| instead, the review found R / |Delta| times ds's rounding,
 //     7e-11 at R = 2, |Delta| = 0.01);
@@ -355,12 +357,11 @@ inline Eigen::Matrix<double, 14, 14> capsule_phi_hessian(const GenericCapsuleSol
 
 }  // namespace
 
-bool generic_capsule_proximity(const Capsule& a, const Pose& pose_a, const Capsule& b,
-                               const Pose& pose_b, Proximity& result) {
+Proximity generic_capsule_proximity(const Capsule& a, const Pose& pose_a, const Capsule& b,
+                                    const Pose& pose_b, GeneralCapsuleProximity general) {
   GenericCapsuleSolution solution;
-  if (!solve_generic(a, pose_a, b, pose_b, solution)) return false;
-  fill_proximity(solution, a, pose_a, b, pose_b, result);
-  return true;
+  if (!solve_generic(a, pose_a, b, pose_b, solution)) return general(a, pose_a, b, pose_b);
+  return generic_proximity(solution, a, pose_a, b, pose_b);
 }
 
 bool solve_generic_capsules(const Capsule& a, const Pose& pose_a, const Capsule& b,
@@ -374,8 +375,7 @@ bool solve_generic_capsules(const Capsule& a, const Pose& pose_a, const Capsule&
 ProximityJacobian generic_capsule_proximity_jacobian(const GenericCapsuleSolution& solution,
                                                      const Capsule& a, const Pose& pose_a,
                                                      const Capsule& b, const Pose& pose_b) {
-  Proximity first;
-  fill_proximity(solution, a, pose_a, b, pose_b, first);
+  const Proximity first = generic_proximity(solution, a, pose_a, b, pose_b);
   const PointsMotion motion = points_motion(solution, free_motion(solution), a, b, first.normal);
   return {first, point_columns(motion.core, solution.scale),
           point_columns(motion.surface, solution.scale)};
@@ -384,8 +384,7 @@ ProximityJacobian generic_capsule_proximity_jacobian(const GenericCapsuleSolutio
 ProximityHessian generic_capsule_proximity_hessian(const GenericCapsuleSolution& solution,
                                                    const Capsule& a, const Pose& pose_a,
                                                    const Capsule& b, const Pose& pose_b) {
-  Proximity first;
-  fill_proximity(solution, a, pose_a, b, pose_b, first);
+  const Proximity first = generic_proximity(solution, a, pose_a, b, pose_b);
   const FreeMotion free_coordinates = free_motion(solution);
   const PointsMotion motion = points_motion(solution, free_coordinates, a, b, first.normal);
   return {{first, point_columns(motion.core, solution.scale),

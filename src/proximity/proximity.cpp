@@ -93,15 +93,16 @@ Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& p
 
 // Two capsules in the generic case take one fused pass, half the general pipeline's cost
 // (capsule_proximity.hpp), and so do their Jacobians and Hessian. Each result is built in place:
-// one named result here, prvalues for the others (returned from both branches).
+// prvalues returned from both branches.
 Proximity proximity(const Capsule& a, const Pose& pose_a, const Capsule& b, const Pose& pose_b,
                     const ProximityOptions& options) {
-  Proximity result;
-  if (options.method != Method::kDefault ||
-      !detail::generic_capsule_proximity(a, pose_a, b, pose_b, result)) {
-    result = query<Proximity>(a, pose_a, b, pose_b, options);
-  }
-  return result;
+  if (options.method != Method::kDefault) return query<Proximity>(a, pose_a, b, pose_b, options);
+  return detail::generic_capsule_proximity(
+      a, pose_a, b, pose_b,
+      [](const Capsule& first, const Pose& first_pose, const Capsule& second,
+         const Pose& second_pose) {
+        return query<Proximity>(first, first_pose, second, second_pose, ProximityOptions{});
+      });
 }
 Proximity proximity(const Capsule& a, const Pose& pose_a, const PaddedPolygon& b,
                     const Pose& pose_b, const ProximityOptions& options) {
