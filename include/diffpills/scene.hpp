@@ -32,9 +32,9 @@
 // per body and one over the bodies' bounds, and walks them for the overlapping pairs of bodies
 // checked against each other: about O(n log n) for n primitives at a fixed density, plus the pairs
 // found; the primitives of one body, or of two bodies never checked against each other, are never
-// walked against each other. Only the pairs found get the narrowphase. (bench_scene: at 10^4 bodies about as fast as FCL's
-// DynamicAABBTreeCollisionManager refitting and walking its tree on the same scene, which reports
-// five times the pairs, BENCHMARKS.md.)
+// walked against each other. Only the pairs found get the narrowphase. (bench_scene: at 10^4
+// bodies about as fast as FCL's DynamicAABBTreeCollisionManager refitting and walking its tree on
+// the same scene, which reports five times the pairs, BENCHMARKS.md.)
 //
 // Order. Contacts are sorted by the first body's index, then the second's (bodies[0] < bodies[1],
 // the order of the scene), then the shape indices; each pair is computed with the earlier body's

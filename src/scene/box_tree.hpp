@@ -1,15 +1,15 @@
 // The broadphase of a scene query (scene.hpp): which of n axis-aligned boxes overlap, among the
 // pairs a filter allows.
 //
-// Up to 128 boxes (a robot and its surroundings), every pair is tested directly: cheaper than any
-// tree at that size. Above, bounding-volume hierarchies are built for each query (linear BVHs):
-// centres get Morton codes in their bounding box (10 bits per axis, interleaved), are sorted by
-// them (radix sort, O(n)), and each range of codes is split where its first and last codes first
-// differ: the nodes are the cells of an octree over the centres, down to leaves of at most 2 boxes.
-// A range whose codes are all equal but whose centres are not (a cluster far smaller than the
-// whole, beside one far-away box) gets new codes in its own bounds and is sorted again, so a
-// cluster is split as finely as the rest. Nothing is kept between queries: the trees are a function
-// of the boxes.
+// Up to 128 boxes (a robot and its surroundings), every pair is tested directly: cheaper than
+// building and walking the trees at that size. Above, bounding-volume hierarchies are built for
+// each query (linear BVHs): centres get Morton codes in their bounding box (10 bits per axis,
+// interleaved), are sorted by them (radix sort, O(n)), and each range of codes is split where its
+// first and last codes first differ: the nodes are the cells of an octree over the centres, down
+// to leaves of at most 2 boxes. A range whose codes are all equal but whose centres are not (a
+// cluster far smaller than the whole, beside one far-away box) gets new codes in its own bounds
+// and is sorted again, so a cluster is split as finely as the rest. Nothing is kept between
+// queries: the trees are a function of the boxes.
 //
 // Two levels, as the filters are per group (a body): one tree per group over its boxes, and one
 // tree over the groups' bounds, walked against itself. A node pair of that tree is skipped when

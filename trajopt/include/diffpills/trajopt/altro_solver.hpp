@@ -109,8 +109,8 @@ class AltroSolver {
   // them. One rollout meets several sweeps: the line search's augmented cost, the backward pass,
   // the violation at a convergence, the multiplier update, the next outer iteration's cost and
   // backward pass, a retry with a larger rho. Each evaluated them anew before (a collision query
-  // per obstacle and knot): quadrotor 30.8 -> 21.9 ms, arm 352 -> 209 ms with forward_pass's
-  // derivatives (BENCHMARKS.md).
+  // per obstacle and knot); with forward_pass's derivatives the arm's solve went from 349 to 203
+  // ms (BENCHMARKS.md).
   const std::vector<Constraints>& constraints_at(Rollout& r, bool derivatives) const;
   void rollout(Rollout& r) const;
   static bool finite_states(const Rollout& r);
@@ -363,15 +363,12 @@ bool AltroSolver<Nx, Nu>::forward_pass(Rollout& r, double& cost, int steps) {
       problem_.dynamics(candidate.x[k], candidate.u[k], candidate.x[k + 1], candidate.A[k],
                         candidate.B[k]);
     }
-    // The full step is accepted most of the time (the quadrotor: 173 of 200 trials were first
-    // trials), and the next backward pass needs the derivatives at the accepted rollout: they
-    // are evaluated with the values on the first trial and kept with the rollout. Shorter steps
-    // are less likely to be taken, and get values only.
     // With derivatives, although only the values decide: the trial taken is the rollout of the
     // next backward pass, which then finds them kept, and most trials are taken (the quadrotor:
     // 173 of 200). A value sweep per trial, then a derivative sweep for the backward pass, cost
-    // more on all three examples: the arm took 224 ms evaluating derivatives on first trials
-    // only, 209 ms on every trial (its derivatives cost little more than the scene query).
+    // more on all three examples; derivatives on the first trial only and values on shorter
+    // steps cost more on the arm (224 ms against 209 in one paired run: its derivatives cost
+    // little more than its scene queries).
     constraints_at(candidate, true);
     const double new_cost = augmented_cost(candidate);
     const double expected = -(alpha * expected_linear_ + alpha * alpha * expected_quadratic_);

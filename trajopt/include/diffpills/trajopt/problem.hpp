@@ -88,9 +88,12 @@ class ProblemOf {
 
   // Values only, where no derivatives are needed: the cost's values in the line search, the
   // constraint values in the polish's trial steps and in the Ipopt bridge's constraint function.
-  // The defaults call the full evaluations; a problem overrides them when that saves work. (The
-  // line search evaluates constraints() with derivatives, which ALTRO keeps for the backward pass
-  // at the rollout it accepts: see AltroSolver::constraints_at.)
+  // The defaults call the full evaluations; a problem overrides them when that saves work. An
+  // override must return what the full evaluation would (constraint_values: the same value and
+  // equalities as constraints): the solvers take either at a point, and the row rules above are
+  // checked where each is called, so a constraint_values that disagrees is seen only in the
+  // polish. (The line search evaluates constraints() with derivatives, which ALTRO keeps for the
+  // backward pass at the rollout it accepts: see AltroSolver::constraints_at.)
   virtual double stage_cost_value(int k, const State& x, const Control& u) const {
     return stage_cost(k, x, u).value;
   }

@@ -36,7 +36,7 @@ struct DenseProduct {
 // derivative(x, u, xdot, Fx, Fu) evaluates F and its Jacobians Fx (N x N), Fu (N x M).
 // product(Fx, S) returns Fx S for the stages' Jacobians S: the three stages after the first cost
 // an N x N x (N + M) product each, and a model whose Fx has known zeros can skip them (the
-// quadrotor's has 52 nonzeros of 169).
+// quadrotor's is zero outside 58 of its 169 entries).
 template <int N, int M, class Derivative, class Product = DenseProduct>
 void rk4_step(const Derivative& derivative, double h, const Eigen::Matrix<double, N, 1>& x,
               const Eigen::Matrix<double, M, 1>& u, Eigen::Matrix<double, N, 1>& next,
