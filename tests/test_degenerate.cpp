@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "diffpills/diffpills.hpp"
+#include "proximity/polygon_features.hpp"
 #include "support/random_shapes.hpp"
 #include "support/reference.hpp"
 #include "support/scene_helpers.hpp"
@@ -421,6 +422,56 @@ TEST(Degenerate, NeedleWhoseApexIsBelowTheRounding) {
       const double phi =
           swapped ? proximity(capsule, capsule_pose, needle, pose, {Method::kInteriorPoint}).phi
                   : proximity(needle, pose, capsule, capsule_pose, {Method::kInteriorPoint}).phi;
+      EXPECT_NEAR(phi, expected, 1e-6) << "swapped " << swapped;
+    } catch (const SolverError&) {
+      // the documented answer where the reference cannot resolve the spike
+    }
+  }
+}
+
+// fuzz_proximity's second needle: two sides whose normals differ from opposite by ~2e-172, so
+// that the bevel at the apex (the sum of the two normals, normalized) has a squared norm that
+// underflows. Eigen's normalized() returned it unscaled, 2e-172 long, and the bevel cut nothing:
+// the interior-point reference's point 1.2 beyond the tip passed check_inside and phi came out
+// 1.41 too small. The rows as the fuzzer wrote them (most redundant); the polygon is the triangle
+// with apex (~0, 1/16) and base y = -1/24 at x ~ 1e-173.
+TEST(Degenerate, NeedleWhoseBevelNormalUnderflows) {
+  Eigen::MatrixX2d C(17, 2);
+  C << -5.8025197824417076e-50, 1.25, 1e-300, 1e-300, 1.25, 1.25, 1.25, 0.125, 0.125,
+      1.506200933628582e-314, 0.125, 2.8413210118836735e-173, 0.125, 0.125, -1.75, 0.125, 0.125,
+      0.125, 0.125, 0.125, -0.375, -3, 1e-300, 0.125, 1.25, 3, 7.8303653615982294e-54, 2.625,
+      -1e+100, 1.25, 1.25, 0.125, -1.875, 2.841321139066013e-173;
+  Eigen::VectorXd d(17);
+  d << 1.25, 1.25, 1.25, 0.125, 0.125, 1e-300, 0.125, 0.125, 0.125, 0.125, 0.125, 0.125, 3, 2.625,
+      1.25, 0.125, 2.841321139066013e-173;
+  const PaddedPolygon needle(C, d, 2.811931526054308e-242);
+  const detail::PolygonView view(needle, 1.0);
+  EXPECT_TRUE(detail::contains(view, Eigen::Vector2d(0, 0.06), 1e-9));
+  EXPECT_FALSE(detail::contains(view, Eigen::Vector2d(0, 0.07), 1e-9));  // beyond the apex
+  EXPECT_FALSE(detail::contains(view, Eigen::Vector2d(0, 1.25), 1e-9));
+
+  Eigen::MatrixX2d triangle_rows(3, 2);
+  triangle_rows << 1, 0, -0.49999999999999978, 0.86602540378443871, -0.50000000000000044,
+      -0.86602540378443837;
+  const double tiny = 2.841321139066013e-173;
+  const PaddedPolygon speck(triangle_rows, Eigen::Vector3d::Constant(tiny), tiny);
+  const Pose needle_pose({0.125, 0.125, 1.25}, {0.70710678118654757, -0.70710678118654757, 0, 0});
+  const Pose speck_pose(
+      {-7.1600071019521985e-153, -7.1600071019521985e-153, -5.7528439046457733e-93},
+      {0.5, 0.5, 0.5, 0.5});
+  // The needle's body y runs along world -z from z = 1.25: its tip is the closest point to the
+  // speck at the origin (within 1e-92). The tip is where rows 5 and 16 meet: 0.125 x + a y =
+  // 1e-300 and -1.875 x + b y = b give y = (b + 1.5e-299) / (15 a + b), x ~ 1e-173.
+  const double a = C(5, 1), b = C(16, 1);
+  const double tip = (b + 1.5e-299) / (15 * a + b);
+  const double expected = 0.125 * 0.125 * 2 + (1.25 - tip) * (1.25 - tip);
+  EXPECT_NEAR(proximity(needle, needle_pose, speck, speck_pose).phi, expected, 1e-12);
+  EXPECT_NEAR(proximity(speck, speck_pose, needle, needle_pose).phi, expected, 1e-12);
+  for (const bool swapped : {false, true}) {
+    try {
+      const double phi =
+          swapped ? proximity(speck, speck_pose, needle, needle_pose, {Method::kInteriorPoint}).phi
+                  : proximity(needle, needle_pose, speck, speck_pose, {Method::kInteriorPoint}).phi;
       EXPECT_NEAR(phi, expected, 1e-6) << "swapped " << swapped;
     } catch (const SolverError&) {
       // the documented answer where the reference cannot resolve the spike

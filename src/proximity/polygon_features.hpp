@@ -70,13 +70,17 @@ class PolygonView : public PolygonBoundary<PolygonView> {
 // n_{i+1} at more than 90 degrees, a < 90): the row m . y <= m . v_i + s with m the unit bisector
 // of the normals, which passes through the vertex and cuts nothing of the polygon itself. Grown
 // rows and bevels then stay within s sqrt(2) of the polygon. n_i + n_{i+1} is exact where its
-// components cancel (Sterbenz), so m is as accurate as the normals even for a ~1e-16 apex.
-// Returns false where vertex i is no spike.
+// components cancel (Sterbenz), so m is as accurate as the normals even for a ~1e-16 apex. Its
+// length is normalized stably (scaled by its largest component first): at an apex of ~1e-172 its
+// squared norm underflows to 0, and Eigen's normalized() then returns it unscaled, a bevel of
+// length 1e-172 that cut nothing (fuzz_proximity: the interior-point reference's point 1.2 beyond
+// such a needle's tip passed the check, phi 1.41 too small). Returns false where vertex i is no
+// spike.
 template <class Polygon>
 bool spike_bevel(const Polygon& polygon, Eigen::Index i, Eigen::Vector2d& normal, double& offset) {
   const Eigen::Vector2d n = polygon.normal(i), next = polygon.normal(polygon.next(i));
   if (!(n.dot(next) < 0.0)) return false;
-  normal = (n + next).normalized();
+  normal = (n + next).stableNormalized();
   offset = normal.dot(polygon.vertex(i));
   return true;
 }
