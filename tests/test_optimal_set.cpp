@@ -177,6 +177,23 @@ TEST(OptimalSet, ManySidedPolygonAFewPicoradiansFromParallel) {
   }
 }
 
+// A regular octagon over a large square, turned 1.2e-12 rad about x (past the 1e-12 of parallel
+// planes): its top edge, along x, stays exactly parallel to the square and is the optimal set,
+// and the edge beside it rises by only ~1e-12 of its length, so both edges at the lowest vertex
+// pass the parallel test. The middle of the top edge is returned (a hostile review: dropping both
+// intervals returned one end or the other, 0.77 apart, under rigid motions).
+TEST(OptimalSet, OctagonTiltedAboutItsEdgeAFewPicoradians) {
+  Eigen::MatrixX2d C(8, 2);  // rows at 0, 45, .., 315 degrees: the top edge's normal is +y
+  for (int k = 0; k < 8; ++k) C.row(k) << std::cos(M_PI / 4 * k), std::sin(M_PI / 4 * k);
+  const double apothem = std::cos(M_PI / 8);
+  const PaddedPolygon octagon(C, Eigen::VectorXd::Constant(8, apothem), 0.0);
+  const PaddedPolygon floor = square(4.0, 0.0);
+  const double tilt = 1.2e-12;
+  const Pose turned({0.1, 0.2, 0.5}, about(-tilt, 1, 0, 0));  // y to -z: the top edge is lowest
+  const Eigen::Vector3d middle(0.1, 0.2 + apothem * std::cos(tilt), 0.5 - apothem * std::sin(tilt));
+  expect_middle(floor, Pose(), octagon, turned, {middle.x(), middle.y(), 0}, middle);
+}
+
 // A box face (a square in a vertical plane) standing on a table: its bottom edge x in [-0.4, 0.6]
 // meets the table x in [-0.5, 0.5]; raised by 0.1 it hovers over the same interval; a wider box
 // hangs over both sides of the table.

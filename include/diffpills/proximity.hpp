@@ -30,9 +30,10 @@
 //   - Parallelism thresholds are relative, so they mean the same at every scale: |sin| <= 1e-12
 //     between a segment and a segment, a plane or another plane (where the distance varies
 //     linearly with a tilt, so the middle of the optimal set stays within 1e-12 of optimal).
-//     A many-sided polygon a few 1e-12 rad from parallel to another's face can have both edges
-//     at its lowest vertex pass the test: that vertex, the one closest point, is returned, not
-//     either edge's interval (which one tied first went with rounding and the shapes' order).
+//     A polygon a few 1e-12 rad from parallel to another's face can have both edges at its
+//     lowest vertex pass the test: the clearly flatter one (its slope at most half the other's)
+//     gives the interval, and for slopes within a factor of two (a regular many-sided polygon
+//     pointing its vertex down the slope) the vertex, the one closest point.
 //     The optimal set is found from the candidates that tie: distances within 2e-12 of the larger
 //     core's size plus 64 ulps of the scene's size, and the point candidate on the interval.
 //     Shapes far apart compared to their size (a distance V, sizes h) have their closest points

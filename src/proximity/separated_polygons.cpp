@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <type_traits>
 #include <vector>
 
@@ -127,34 +128,46 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
           false);
     }
     // The two edges at the support vertex, each an interval of closest points if parallel to the
-    // face. Not when both are: the polygon's plane is then within a few 1e-12 rad of the face's
-    // (not parallel, or that branch would have taken it) and many-sided, the support vertex
-    // where the two edges meet is the one closest point, and each edge's interval only ties with
-    // it within the tolerance. Which of the two won the tie went with rounding, and so with the
-    // order of the shapes (a hostile review: a 133-gon and a 129-gon 6e-12 rad apart, the points
-    // 0.015 apart between the two orders); the vertex is offered alone.
+    // face (its part over the face, one candidate). Both can pass the test when the polygon's
+    // plane is within a few 1e-12 rad of the face's (not parallel, or that branch would have
+    // taken it). Then the clearly flatter one gives the interval, its slope at most half the
+    // other's (an edge exactly parallel to the face, the optimal set, has a slope of rounding
+    // beside its neighbour's >= 1e-14), and for slopes within a factor of two of each other
+    // neither does: the vertex where they meet is the one closest point (a regular many-sided
+    // polygon pointing its vertex down the slope). Compared by height, the lower interval
+    // winning, two such intervals tied to rounding, and the points went with the order of the
+    // shapes and with rigid motions (hostile reviews: a 133-gon and a 129-gon 6e-12 rad apart,
+    // points 0.015 apart; an octagon tilted 1.2e-12 rad about an edge).
     const Eigen::Index following = support + 1 == polygon.size() ? 0 : support + 1;
-    const auto flat = [&](Eigen::Index j) {
+    std::array<std::optional<Candidate>, 2> intervals;
+    std::array<double, 2> slopes = {0.0, 0.0};
+    for (std::size_t side = 0; side < 2; ++side) {
+      const Eigen::Index j = side == 0 ? support : following;
       const Eigen::Vector3d& start = polygon.start(j);
       const Eigen::Vector3d& end = polygon.end(j);
-      return std::abs(end.z() - start.z()) <= 1e-12 * (end - start).norm();
-    };
-    const bool support_flat = flat(support), following_flat = flat(following);
-    if (support_flat && following_flat) return;
-    for (const Eigen::Index j : {support, following}) {
-      if (!(j == support ? support_flat : following_flat)) continue;
-      const Eigen::Vector3d& start = polygon.start(j);
-      const Eigen::Vector3d& end = polygon.end(j);
+      const double length = (end - start).norm();
+      if (std::abs(end.z() - start.z()) > 1e-12 * length) continue;
       const auto [low, high] = clip_line(over, start.head<2>(), (end - start).head<2>(), tolerance);
       if (low <= high) {
         const double middle = 0.5 * (low + high);
-        const double height = start.z() + middle * (end.z() - start.z());
+        slopes[side] = std::abs(end.z() - start.z()) / length;
         // The interval: a part of the polygon's edge, and its shadow on the face.
         const double half = 0.5 * (high - low);
-        best.offer(candidate(Kind::kBEdgeOverA, Kind::kAEdgeOverB, j, middle, height,
-                             half * (end - start).norm(), half * (end - start).head<2>().norm()),
-                   true);
+        intervals[side] = candidate(Kind::kBEdgeOverA, Kind::kAEdgeOverB, j, middle,
+                                    start.z() + middle * (end.z() - start.z()), half * length,
+                                    half * (end - start).head<2>().norm());
       }
+    }
+    if (intervals[0] && intervals[1]) {
+      if (slopes[0] <= 0.5 * slopes[1]) {
+        best.offer(*intervals[0], true);
+      } else if (slopes[1] <= 0.5 * slopes[0]) {
+        best.offer(*intervals[1], true);
+      }
+      return;
+    }
+    for (const std::optional<Candidate>& interval : intervals) {
+      if (interval) best.offer(*interval, true);
     }
   };
   const bool above = polygon[lowest].z() > -tolerance, below = polygon[highest].z() < tolerance;
