@@ -388,6 +388,25 @@ TEST(Degenerate, SliversAgainstTheBruteForce) {
   EXPECT_NEAR(proximity(plate, above, spike, Pose()).phi, expected, 1e-12);
 }
 
+// A needle polygon against another shape, both orders: the default path's phi to 1e-12 of the
+// expected one; the interior-point reference's to 1e-6, or SolverError, the documented answer
+// where the reference cannot resolve the spike.
+template <class Other>
+void expect_needle_answers(const PaddedPolygon& needle, const Pose& needle_pose, const Other& other,
+                           const Pose& other_pose, double expected) {
+  EXPECT_NEAR(proximity(needle, needle_pose, other, other_pose).phi, expected, 1e-12);
+  EXPECT_NEAR(proximity(other, other_pose, needle, needle_pose).phi, expected, 1e-12);
+  for (const bool swapped : {false, true}) {
+    try {
+      const double phi =
+          swapped ? proximity(other, other_pose, needle, needle_pose, {Method::kInteriorPoint}).phi
+                  : proximity(needle, needle_pose, other, other_pose, {Method::kInteriorPoint}).phi;
+      EXPECT_NEAR(phi, expected, 1e-6) << "swapped " << swapped;
+    } catch (const SolverError&) {
+    }
+  }
+}
+
 // fuzz_proximity's needle: a strip 1.2e-91 wide whose two sides differ in direction by 3e-16, so
 // that they cross 4e-76 from the origin; the row through the origin (d = 1e-300) is dropped as
 // cutting off nothing resolvable, and the polygon is a triangle 1.4 long and 5e-15 wide at its
@@ -415,18 +434,7 @@ TEST(Degenerate, NeedleWhoseApexIsBelowTheRounding) {
   const long double gap =
       brute_force_closest(to_world(as_segment, pose), to_world(core, capsule_pose)).distance;
   const double expected = static_cast<double>(gap * gap) - 2.875 * 2.875;
-  EXPECT_NEAR(proximity(needle, pose, capsule, capsule_pose).phi, expected, 1e-12);
-  EXPECT_NEAR(proximity(capsule, capsule_pose, needle, pose).phi, expected, 1e-12);
-  for (const bool swapped : {false, true}) {
-    try {
-      const double phi =
-          swapped ? proximity(capsule, capsule_pose, needle, pose, {Method::kInteriorPoint}).phi
-                  : proximity(needle, pose, capsule, capsule_pose, {Method::kInteriorPoint}).phi;
-      EXPECT_NEAR(phi, expected, 1e-6) << "swapped " << swapped;
-    } catch (const SolverError&) {
-      // the documented answer where the reference cannot resolve the spike
-    }
-  }
+  expect_needle_answers(needle, pose, capsule, capsule_pose, expected);
 }
 
 // fuzz_proximity's second needle: two sides whose normals differ from opposite by ~2e-172, so
@@ -465,18 +473,7 @@ TEST(Degenerate, NeedleWhoseBevelNormalUnderflows) {
   const double a = C(5, 1), b = C(16, 1);
   const double tip = (b + 1.5e-299) / (15 * a + b);
   const double expected = 0.125 * 0.125 * 2 + (1.25 - tip) * (1.25 - tip);
-  EXPECT_NEAR(proximity(needle, needle_pose, speck, speck_pose).phi, expected, 1e-12);
-  EXPECT_NEAR(proximity(speck, speck_pose, needle, needle_pose).phi, expected, 1e-12);
-  for (const bool swapped : {false, true}) {
-    try {
-      const double phi =
-          swapped ? proximity(speck, speck_pose, needle, needle_pose, {Method::kInteriorPoint}).phi
-                  : proximity(needle, needle_pose, speck, speck_pose, {Method::kInteriorPoint}).phi;
-      EXPECT_NEAR(phi, expected, 1e-6) << "swapped " << swapped;
-    } catch (const SolverError&) {
-      // the documented answer where the reference cannot resolve the spike
-    }
-  }
+  expect_needle_answers(needle, needle_pose, speck, speck_pose, expected);
 }
 
 }  // namespace
