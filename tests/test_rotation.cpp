@@ -133,6 +133,36 @@ TEST(Rotation, LeftAndRightMultiplyAndAttitudeJacobian) {
   }
 }
 
+// attitude_gradient is built on the product matrices of q as given, yet it is the gradient along
+// the body-frame rotation q (x) exp(theta) for a non-unit q too, and the same for every scaling
+// of q: a dphi/dq that includes the normalization scales as 1 / |q| (rotation.hpp).
+TEST(Rotation, AttitudeGradientOfANonUnitQuaternion) {
+  Rng rng(5);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector4d q = random_quaternion(rng);
+    const Eigen::Vector3d v = random_vector(rng), w = random_vector(rng);
+    const Eigen::Vector3d reduced = attitude_gradient(q, rotate_gradient(q, v, w));
+    for (const double factor : {1e-3, 0.37, 3.1, 1e3}) {
+      const Eigen::Vector4d scaled = factor * q;
+      const Eigen::Vector3d of_scaled = attitude_gradient(scaled, rotate_gradient(scaled, v, w));
+      EXPECT_LE((of_scaled - reduced).norm(), 1e-13 * (1 + reduced.norm())) << i << " " << factor;
+    }
+    // Central differences of w . Q(q (x) exp(theta)) v over theta, q (x) exp(theta) not unit.
+    const auto phi = [&](int axis, double angle) {
+      const Eigen::Quaterniond turned =
+          Eigen::Quaterniond(q(0), q(1), q(2), q(3)) *
+          Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::Unit(axis)));
+      return w.dot(
+          rotation_matrix(Eigen::Vector4d(turned.w(), turned.x(), turned.y(), turned.z())) * v);
+    };
+    for (int j = 0; j < 3; ++j) {
+      const double step = 1e-6;
+      const double numeric = (phi(j, step) - phi(j, -step)) / (2 * step);
+      EXPECT_NEAR(reduced(j), numeric, 1e-8 * (1 + v.norm() * w.norm())) << i << " " << j;
+    }
+  }
+}
+
 TEST(Rotation, ModifiedRodriguesParametersRoundTrip) {
   Rng rng(4);
   for (int i = 0; i < 1000; ++i) {

@@ -1,10 +1,13 @@
 // Quaternion and rotation utilities (DESIGN.md section 1).
 //
 // Conventions: q = [w, x, y, z], scalar first, Hamilton product, rotating body to world:
-// x_world = r + Q(q) x_body. Every function that takes a quaternion accepts a non-unit one and
-// normalizes it internally; derivatives with respect to q include that normalization, so at a
-// unit q they have no component along q. Callers are expected to pass a validated quaternion
-// (see Pose); these functions do not check for zero norm.
+// x_world = r + Q(q) x_body. The functions that rotate (rotation_matrix, rotate_*,
+// quaternion_to_mrp) accept a non-unit q and normalize it internally; their derivatives with
+// respect to q include that normalization, so at a unit q they have no component along q. The
+// product matrices (left_multiply_matrix, right_multiply_matrix, attitude_jacobian) are those of
+// q as given, linear in q; attitude_gradient, built on them, is still the same for every scaling
+// of q, since a dphi/dq that includes the normalization scales as 1 / |q|. Callers are expected
+// to pass a validated quaternion (see Pose); these functions do not check for zero norm.
 #pragma once
 
 #include <Eigen/Core>
