@@ -57,7 +57,7 @@ nlohmann::ordered_json answer(const json& query) {
                : to_json(proximity(a.shape, a.pose, b.shape, b.pose, options));
   if (hessian) {
     out["hessian"] =
-        matrix_rows(proximity_hessian(a.shape, a.pose, b.shape, b.pose, options).hessian);
+        matrix_rows(proximity_with_hessian(a.shape, a.pose, b.shape, b.pose, options).hessian);
   }
   if (shape_gradient) {
     out["shape_gradient"] =

@@ -102,6 +102,33 @@ void run_hessian(benchmark::State& state, const A& a, const B& b) {
   }
 }
 
+// proximity_with_hessian: phi, the gradient and the 14x14 Hessian, without the Jacobians.
+template <class A, class B>
+void run_with_hessian(benchmark::State& state, const A& a, const B& b) {
+  const Scene& s = scene();
+  const Shape shape_a = a, shape_b = b;
+  int i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(proximity_with_hessian(shape_a, s.a[i], shape_b, s.b[i]));
+    i = (i + 1) % kPoses;
+  }
+}
+
+// proximity_with_hessian of two capsules with the Hessian's vector kernel (symmetric_gram.hpp)
+// held to each instruction set this CPU runs (Highway's targets, widest first), labelled.
+void CapsuleCapsule_WithHessian_InstructionSet(benchmark::State& state) {
+  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  const auto index = static_cast<std::size_t>(state.range(0));
+  if (index >= targets.size()) {
+    state.SkipWithError("no such instruction set here");
+    return;
+  }
+  hwy::SetSupportedTargetsForTest(targets[index]);
+  state.SetLabel(hwy::TargetName(targets[index]));
+  run_with_hessian(state, kCapsuleA, kCapsuleB);
+  hwy::SetSupportedTargetsForTest(0);
+}
+
 // FCL's transform of one of our poses; `capsule` adds the z-to-x axis change.
 fcl::Transform3d fcl_pose(const Pose& pose, bool capsule) {
   const Eigen::Quaterniond q(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
@@ -192,6 +219,7 @@ void HexagonHexagon_InteriorPoint(benchmark::State& s) {
 }
 void CapsuleCapsule_Jacobian(benchmark::State& s) { run_jacobian(s, kCapsuleA, kCapsuleB); }
 void CapsuleCapsule_Hessian(benchmark::State& s) { run_hessian(s, kCapsuleA, kCapsuleB); }
+void CapsuleCapsule_WithHessian(benchmark::State& s) { run_with_hessian(s, kCapsuleA, kCapsuleB); }
 void CapsuleCapsule_FclDistance(benchmark::State& s) {
   const fcl::Capsuled a(0.2, 1.2), b(0.15, 0.8);
   run_fcl(s, a, true, b, true);
@@ -201,6 +229,7 @@ void CapsuleHexagon_Proximity(benchmark::State& s) {
 }
 void CapsuleHexagon_Jacobian(benchmark::State& s) { run_jacobian(s, kCapsuleA, kHexagonA); }
 void CapsuleHexagon_Hessian(benchmark::State& s) { run_hessian(s, kCapsuleA, kHexagonA); }
+void CapsuleHexagon_WithHessian(benchmark::State& s) { run_with_hessian(s, kCapsuleA, kHexagonA); }
 void CapsuleHexagon_FclDistance(benchmark::State& s) {
   const fcl::Capsuled a(0.2, 1.2);
   run_fcl(s, a, true, *fcl_hexagon(kHexagonA), false);
@@ -210,6 +239,7 @@ void HexagonHexagon_Proximity(benchmark::State& s) {
 }
 void HexagonHexagon_Jacobian(benchmark::State& s) { run_jacobian(s, kHexagonA, kHexagonB); }
 void HexagonHexagon_Hessian(benchmark::State& s) { run_hessian(s, kHexagonA, kHexagonB); }
+void HexagonHexagon_WithHessian(benchmark::State& s) { run_with_hessian(s, kHexagonA, kHexagonB); }
 void HexagonHexagon_FclDistance(benchmark::State& s) {
   run_fcl(s, *fcl_hexagon(kHexagonA), false, *fcl_hexagon(kHexagonB), false);
 }
@@ -597,16 +627,20 @@ BENCHMARK(CapsuleCapsule_Proximity);
 BENCHMARK(CapsuleCapsule_InteriorPoint);
 BENCHMARK(CapsuleCapsule_Jacobian);
 BENCHMARK(CapsuleCapsule_Hessian);
+BENCHMARK(CapsuleCapsule_WithHessian);
+BENCHMARK(CapsuleCapsule_WithHessian_InstructionSet)->DenseRange(0, 4);
 BENCHMARK(CapsuleHexagon_FclDistance);
 BENCHMARK(CapsuleHexagon_Proximity);
 BENCHMARK(CapsuleHexagon_InteriorPoint);
 BENCHMARK(CapsuleHexagon_Jacobian);
 BENCHMARK(CapsuleHexagon_Hessian);
+BENCHMARK(CapsuleHexagon_WithHessian);
 BENCHMARK(HexagonHexagon_FclDistance);
 BENCHMARK(HexagonHexagon_Proximity);
 BENCHMARK(HexagonHexagon_InteriorPoint);
 BENCHMARK(HexagonHexagon_Jacobian);
 BENCHMARK(HexagonHexagon_Hessian);
+BENCHMARK(HexagonHexagon_WithHessian);
 BENCHMARK(CapsuleCapsule_FclSignedDistance);
 BENCHMARK(CapsuleCapsule_SignedDistance);
 BENCHMARK(CapsuleHexagon_FclSignedDistance);

@@ -8,14 +8,18 @@
 // (nearly parallel axes, close cores, short capsules, tiny scenes) agree with the brute force too,
 // so nothing jumps where the path changes.
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <string>
 #include <vector>
 
 #include "diffpills/diffpills.hpp"
 #include "proximity/capsule_proximity.hpp"
+#include "proximity/symmetric_gram.hpp"
 #include "support/random_shapes.hpp"
 #include "support/reference.hpp"
 
@@ -133,8 +137,18 @@ void expect_matches_references(const Pair& p, double tolerance) {
       ASSERT_NEAR(second.hessian(row, column), general.hessian(row, column),
                   tolerance * (unit + std::abs(general.hessian(row, column))))
           << row << ", " << column;
+      ASSERT_EQ(second.hessian(row, column), second.hessian(column, row)) << row << ", " << column;
     }
   }
+  // proximity_with_hessian: the same pass without the Jacobians, every field bit for bit.
+  const ProximityWithHessian lean =
+      proximity_with_hessian(Shape(p.a), p.pose_a, Shape(p.b), p.pose_b);
+  ASSERT_EQ(lean.phi, fast.phi);
+  ASSERT_EQ(lean.gradient, fast.gradient);
+  ASSERT_EQ(lean.normal, fast.normal);
+  ASSERT_EQ(lean.points[1], fast.points[1]);
+  ASSERT_EQ(lean.core_points[0], fast.core_points[0]);
+  ASSERT_EQ(lean.hessian, second.hessian);
 }
 
 Pair random_pair(Rng& rng, double scale) {
@@ -158,6 +172,25 @@ TEST(CapsuleProximity, RandomPairsMatchBruteForceAndTheGeneralPipeline) {
     // The path is what random poses take: the test exercises it, not the fallback.
     EXPECT_GT(answered, 0.85 * n) << "scale " << scale;
   }
+}
+
+// The Hessian's dense part runs in the widest vectors the CPU has (symmetric_gram.hpp): the same
+// checks on every instruction set it was compiled for, each near the general pipeline and exactly
+// symmetric (test_symmetric_gram.cpp checks the kernel alone).
+TEST(CapsuleProximity, HessianOnEveryInstructionSet) {
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    SCOPED_TRACE(std::string("target ") + hwy::TargetName(target));
+    ASSERT_STREQ(detail::symmetric_gram_target(), hwy::TargetName(target));
+    Rng rng(1309);
+    for (int i = 0; i < 300; ++i) {
+      const Pair p = random_pair(rng, 1.0);
+      if (!generic(p)) continue;
+      SCOPED_TRACE(i);
+      expect_matches_references(p, 1e-13);
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
 }
 
 // Central differences of phi in every position coordinate and every raw quaternion component

@@ -279,6 +279,43 @@ TEST(Hessian, SwappingTheShapesPermutesTheBlocks) {
   }
 }
 
+// proximity_with_hessian is proximity_hessian without the Jacobians: every field it has is the
+// same, bit for bit, for every ordering, both methods, apart and with intersecting cores (half the
+// pairs close together).
+TEST(Hessian, WithHessianRepeatsProximityHessian) {
+  Rng rng(35);
+  int intersecting = 0;
+  for (int trial = 0; trial < 800; ++trial) {
+    const TestShape ta = random_shape(rng, trial % 2 == 0), tb = random_shape(rng, trial % 4 < 2);
+    const double spread = trial % 3 == 0 ? 0.2 : 1.5;
+    const Pose pa = random_pose(rng, spread), pb = random_pose(rng, spread);
+    for (const Method method : {Method::kDefault, Method::kInteriorPoint}) {
+      ProximityHessian full;
+      try {
+        full = proximity_hessian(ta.shape, pa, tb.shape, pb, {method});
+      } catch (const SolverError&) {
+        EXPECT_THROW(proximity_with_hessian(ta.shape, pa, tb.shape, pb, {method}), SolverError);
+        continue;
+      }
+      const ProximityWithHessian lean =
+          proximity_with_hessian(ta.shape, pa, tb.shape, pb, {method});
+      SCOPED_TRACE(::testing::Message()
+                   << "trial " << trial << " method " << static_cast<int>(method));
+      EXPECT_EQ(lean.phi, full.phi);
+      EXPECT_EQ(lean.gradient, full.gradient);
+      EXPECT_EQ(lean.normal, full.normal);
+      EXPECT_EQ(lean.cores_intersect, full.cores_intersect);
+      for (int i = 0; i < 2; ++i) {
+        EXPECT_EQ(lean.core_points[i], full.core_points[i]);
+        EXPECT_EQ(lean.points[i], full.points[i]);
+      }
+      EXPECT_EQ(lean.hessian, full.hessian);
+      intersecting += full.cores_intersect;
+    }
+  }
+  EXPECT_GT(intersecting, 10) << "too few intersecting pairs to test that branch";
+}
+
 // An analytic case: two points (capsules of length 0) at distance vector e = r1 - r2: phi =
 // |e|^2 - R^2, whose Hessian in (r1, r2) is 2 [I -I; -I I] and 0 in the quaternions.
 TEST(Hessian, TwoSpheres) {

@@ -70,8 +70,8 @@ Eigen::Matrix<double, 5, 5> state_hessian(const Eigen::Matrix<double, 14, 14>& H
 
 Eigen::Matrix<double, 5, 5> car_bus_phi_hessian(const CarBusScenario& scenario,
                                                 const Eigen::Ref<const Eigen::VectorXd>& x) {
-  const ProximityHessian p =
-      proximity_hessian(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
+  const ProximityWithHessian p =
+      proximity_with_hessian(scenario.car, car_pose(x), scenario.bus, scenario.bus_pose);
   return state_hessian(p.hessian, p.gradient, x);
 }
 

@@ -213,7 +213,7 @@ Eigen::MatrixXd QuadrotorWindowProblem::constraint_hessian(int k, const State& x
     if (weight == 0.0) return;
     const Eigen::Matrix<double, 14, 14> measure =
         scenario_.clearance == Clearance::kProximity
-            ? proximity_hessian(scenario_.body, pose, obstacle.shape, obstacle.pose).hessian
+            ? proximity_with_hessian(scenario_.body, pose, obstacle.shape, obstacle.pose).hessian
             : signed_distance_hessian(scenario_.body, pose, obstacle.shape, obstacle.pose).hessian;
     H.topLeftCorner<7, 7>() -= weight * measure.topLeftCorner<7, 7>();
   };

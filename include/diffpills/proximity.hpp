@@ -93,10 +93,13 @@ namespace diffpills {
 enum class Method {
   // Exact fast paths: two segments in closed form (Appendix A's candidates), pairs with a polygon
   // by enumerating feature pairs in a polygon's body frame. No heap allocation for polygons of up
-  // to 32 vertices. proximity(), proximity_jacobian() and proximity_hessian() of two capsules
-  // whose axes are more than ~5.7 degrees apart and whose cores are apart by more than ~1e-2 of
-  // the scene take one fused pass (src/proximity/capsule_proximity.hpp), whose fields the three
-  // share bit for bit and which agrees with the general pipeline to rounding (~1e-13 relative).
+  // to 32 vertices. proximity(), proximity_jacobian(), proximity_hessian() and
+  // proximity_with_hessian() of two capsules whose axes are more than ~5.7 degrees apart and
+  // whose cores are apart by more than ~1e-2 of the scene take one fused pass
+  // (src/proximity/capsule_proximity.hpp), whose fields the four share bit for bit and which
+  // agrees with the general pipeline to rounding (~1e-13 relative). Its Hessian is formed in the
+  // widest vectors the CPU runs (AVX-512, AVX2, SSE4 or plain code, chosen at run time), so its
+  // last bits may differ between machines; it is exactly symmetric on all of them.
   kDefault,
   // The paper's interior-point method (section II-B) on the pair's QP, polished to its active
   // set: slower, kept as the reference the fast paths are tested against.
@@ -133,6 +136,16 @@ struct ProximityHessian : ProximityJacobian {
   Eigen::Matrix<double, 14, 14> hessian = Eigen::Matrix<double, 14, 14>::Zero();
 };
 
+// phi, the points, the normal, the gradient and the same Hessian as ProximityHessian, without the
+// points' Jacobians: what a Newton-type method (Ipopt with exact Hessians, SQP, interior-point MPC)
+// asks of a collision constraint. Every field equals proximity_hessian()'s bit for bit; it only
+// skips the two 6 x 14 Jacobians: two capsules in 2.4-2.9x the time of proximity() on a CPU with
+// AVX2 or AVX-512 (3.0-3.4x with SSE4 alone or plain code) against proximity_hessian()'s ~4x, a
+// capsule and a hexagon 2.2x, two hexagons 1.6x (BENCHMARKS.md).
+struct ProximityWithHessian : Proximity {
+  Eigen::Matrix<double, 14, 14> hessian = Eigen::Matrix<double, 14, 14>::Zero();
+};
+
 // Thrown when the QP solver does not converge, or when the interior-point reference's point lies
 // outside a polygon's spike sharper than its tolerance (src/proximity/proximity.cpp): never
 // silently wrong.
@@ -166,5 +179,8 @@ ProximityJacobian proximity_jacobian(const Shape& a, const Pose& pose_a, const S
 
 ProximityHessian proximity_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
                                    const Pose& pose_b, const ProximityOptions& options = {});
+ProximityWithHessian proximity_with_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
+                                            const Pose& pose_b,
+                                            const ProximityOptions& options = {});
 
 }  // namespace diffpills

@@ -14,6 +14,8 @@ Shapes: ``Capsule(length, radius)`` and ``PaddedPolygon(C, d, radius)``, each po
     keeps a slope where phi is flat (overlapping cores).
 ``proximity_hessian(a, pose_a, b, pose_b)``, ``signed_distance_hessian``
     the same plus the (14, 14) Hessian with respect to both poses.
+``proximity_with_hessian(a, pose_a, b, pose_b)``
+    proximity plus the same Hessian, without the Jacobians: what Newton-type solvers need.
 ``proximity_shape_gradient(a, pose_a, b, pose_b)``, ``signed_distance_shape_gradient``
     the same plus ``shape_gradient``: the derivatives with respect to each shape's own parameters
     (a capsule's length and radius, a polygon's C, d and radius).
@@ -41,6 +43,7 @@ from ._core import (
     ProximityHessian,
     ProximityJacobian,
     ProximityShapeGradient,
+    ProximityWithHessian,
     SignedDistance,
     SignedDistanceHessian,
     SignedDistanceJacobian,
@@ -53,6 +56,7 @@ from ._core import (
     proximity_hessian,
     proximity_jacobian,
     proximity_shape_gradient,
+    proximity_with_hessian,
     signed_distance,
     signed_distance_batch,
     signed_distance_hessian,
@@ -70,6 +74,7 @@ __all__ = [
     "ProximityHessian",
     "ProximityJacobian",
     "ProximityShapeGradient",
+    "ProximityWithHessian",
     "SignedDistance",
     "SignedDistanceHessian",
     "SignedDistanceJacobian",
@@ -82,6 +87,7 @@ __all__ = [
     "proximity_hessian",
     "proximity_jacobian",
     "proximity_shape_gradient",
+    "proximity_with_hessian",
     "signed_distance",
     "signed_distance_batch",
     "signed_distance_hessian",
@@ -113,6 +119,7 @@ for _class in (
     ProximityHessian,
     ProximityJacobian,
     ProximityShapeGradient,
+    ProximityWithHessian,
     Scene,
     SignedDistance,
     SignedDistanceHessian,

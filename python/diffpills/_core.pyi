@@ -105,6 +105,10 @@ class ProximityHessian(ProximityJacobian):
     @property
     def hessian(self) -> np.ndarray: ...
 
+class ProximityWithHessian(Proximity):
+    @property
+    def hessian(self) -> np.ndarray: ...
+
 class SignedDistanceHessian(SignedDistanceJacobian):
     @property
     def normal_jacobian(self) -> np.ndarray: ...
@@ -114,6 +118,9 @@ class SignedDistanceHessian(SignedDistanceJacobian):
 def proximity_hessian(
     a: Shape, pose_a: Pose, b: Shape, pose_b: Pose, method: Method = "default"
 ) -> ProximityHessian: ...
+def proximity_with_hessian(
+    a: Shape, pose_a: Pose, b: Shape, pose_b: Pose, method: Method = "default"
+) -> ProximityWithHessian: ...
 def signed_distance_hessian(a: Shape, pose_a: Pose, b: Shape, pose_b: Pose) -> SignedDistanceHessian: ...
 
 class ProximityShapeGradient(Proximity):

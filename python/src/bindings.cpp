@@ -86,6 +86,9 @@ template <>
 class type_caster<diffpills::ProximityHessian>
     : public diffpills::python::ConstructedCaster<diffpills::ProximityHessian> {};
 template <>
+class type_caster<diffpills::ProximityWithHessian>
+    : public diffpills::python::ConstructedCaster<diffpills::ProximityWithHessian> {};
+template <>
 class type_caster<diffpills::SignedDistanceHessian>
     : public diffpills::python::ConstructedCaster<diffpills::SignedDistanceHessian> {};
 template <>
@@ -710,6 +713,25 @@ hessian  (14, 14): d^2 phi / d[r_a, q_a, r_b, q_b]^2, symmetric (0 where the cor
             p.hessian = fixed_matrix<14, 14>(fields[3], "hessian");
             return p;
           }));
+  py::class_<ProximityWithHessian, Proximity>(m, "ProximityWithHessian",
+                                              R"(The result of diffpills.proximity_with_hessian:
+everything of Proximity, plus
+
+hessian  (14, 14): d^2 phi / d[r_a, q_a, r_b, q_b]^2, symmetric (0 where the cores intersect),
+         the same as proximity_hessian's)")
+      .def_readonly("hessian", &ProximityWithHessian::hessian)
+      .def(py::pickle(
+          [](const ProximityWithHessian& p) -> py::object {
+            return py::make_tuple(proximity_state(p), p.hessian);
+          },
+          [](const py::object& state) {
+            const py::tuple fields =
+                pickled_state(state, 2, std::string("(") + kProximityFields + ", hessian)");
+            ProximityWithHessian p;
+            restore_proximity(p, fields[0]);
+            p.hessian = fixed_matrix<14, 14>(fields[1], "hessian");
+            return p;
+          }));
   py::class_<SignedDistanceHessian, SignedDistanceJacobian>(
       m, "SignedDistanceHessian", R"(The result of diffpills.signed_distance_hessian: everything
 of SignedDistanceJacobian, plus
@@ -1311,6 +1333,21 @@ gradient (14,) = d distance / d[r_a, q_a, r_b, q_b].)");
       py::arg("method") = "default",
       R"(As proximity_jacobian, plus hessian (14, 14): the second derivatives of phi with respect
 to [r_a, q_a, r_b, q_b], quaternion normalization included.)");
+  m.def(
+      "proximity_with_hessian",
+      [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
+         const py::handle& pose_b, const py::handle& method) {
+        const ProximityOptions options{to_method(method)};
+        return pair_query<ProximityWithHessian>(
+            a, pose_a, b, pose_b,
+            [&](const auto& x, const Pose& px, const auto& y, const Pose& py_) {
+              return proximity_with_hessian(Shape(x), px, Shape(y), py_, options);
+            });
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
+      py::arg("method") = "default",
+      R"(As proximity, plus hessian (14, 14), the same as proximity_hessian's, without the points'
+Jacobians: what a Newton-type solver needs of a collision constraint, in less time.)");
   m.def(
       "signed_distance_hessian",
       [](const py::handle& a, const py::handle& pose_a, const py::handle& b,

@@ -241,7 +241,7 @@ def _uninitialised():
         pass
 
     classes = [diffpills.Capsule, diffpills.PaddedPolygon, diffpills.Pose, diffpills.Proximity,
-               diffpills.ProximityJacobian, Subclass]
+               diffpills.ProximityJacobian, diffpills.ProximityWithHessian, Subclass]
     return {cls.__name__: cls.__new__(cls) for cls in classes}
 
 

@@ -45,14 +45,41 @@ def test_results_pickle():
     b, _ = random_capsule(rng)
     for result in (
         diffpills.proximity_hessian(a, random_pose(rng), b, random_pose(rng)),
+        diffpills.proximity_with_hessian(a, random_pose(rng), b, random_pose(rng)),
         diffpills.signed_distance_hessian(a, random_pose(rng, 0.3), b, random_pose(rng, 0.3)),
     ):
         for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
             back = pickle.loads(pickle.dumps(result, protocol=protocol))
             assert type(back) is type(result)
             assert np.array_equal(back.hessian, result.hessian)
-            assert np.array_equal(back.points_jacobian, result.points_jacobian)
+            assert np.array_equal(back.gradient, result.gradient)
+            if hasattr(result, "points_jacobian"):
+                assert np.array_equal(back.points_jacobian, result.points_jacobian)
         with pytest.raises(TypeError, match="made by __new__"):
             type(result).__new__(type(result)).hessian
     sd = diffpills.signed_distance_hessian(a, random_pose(rng), b, random_pose(rng))
     assert sd.normal_jacobian.shape == (3, 14)
+
+
+def test_proximity_with_hessian_is_proximity_hessian_without_the_jacobians():
+    rng = np.random.default_rng(43)
+    makers = (random_capsule, random_polygon)
+    for trial in range(40):
+        a, _ = makers[trial % 2](rng)
+        b, _ = makers[(trial // 2) % 2](rng)
+        pa, pb = random_pose(rng, 0.6), random_pose(rng, 0.6)
+        for method in ("default", "interior_point"):
+            try:
+                full = diffpills.proximity_hessian(a, pa, b, pb, method=method)
+            except diffpills.SolverError:
+                with pytest.raises(diffpills.SolverError):
+                    diffpills.proximity_with_hessian(a, pa, b, pb, method=method)
+                continue
+            lean = diffpills.proximity_with_hessian(a, pa, b, pb, method=method)
+            assert type(lean) is diffpills.ProximityWithHessian
+            assert not hasattr(lean, "points_jacobian")
+            assert lean.phi == full.phi
+            for name in ("gradient", "hessian", "points", "core_points", "normal"):
+                assert np.array_equal(getattr(lean, name), getattr(full, name)), name
+    with pytest.raises(ValueError, match="method"):
+        diffpills.proximity_with_hessian(a, pa, b, pb, method="fast")

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include "symmetric_gram.hpp"
 #include "unit_quaternion.hpp"
 
 namespace diffpills::detail {
@@ -158,14 +159,31 @@ inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3
 
 // du/dq for the unit axis u = Q(q^) e_x of the q as given: J(q^) (I - q^ q^') / |q|, with J's
 // columns as in axis_gradient; J(q^) q^ = 2 u (J is linear in q^ and u quadratic), so this is
-// (J(q^) - 2 u q^') / |q|.
-Eigen::Matrix<double, 3, 4> axis_jacobian(const AxisAttitude& q) {
+// (J(q^) - 2 u q^') / |q|. Row-major: e' du/dq is a sum of three contiguous rows (axis_rate).
+using AxisJacobian = Eigen::Matrix<double, 3, 4, Eigen::RowMajor>;
+
+[[gnu::always_inline]] inline AxisJacobian axis_jacobian(const AxisAttitude& q) {
   const double w = q.unit(0), x = q.unit(1), y = q.unit(2), z = q.unit(3);
-  Eigen::Matrix<double, 3, 4> J;
+  AxisJacobian J;
   J << w, x, -y, -z,  //
       z, y, x, w,     //
       -y, z, -w, x;
   return (2.0 * J - (2.0 * q.axis) * q.unit.transpose()) * q.inverse_norm;
+}
+
+// e' du/dq.
+[[gnu::always_inline]] inline Eigen::RowVector4d axis_rate(const AxisJacobian& J,
+                                                           const Eigen::Vector3d& e) {
+  return e.x() * J.row(0) + e.y() * J.row(1) + e.z() * J.row(2);
+}
+
+// Both capsules' du/dq_a and dv/dq_b, what the Jacobians and the Hessian start from.
+struct AxisJacobians {
+  AxisJacobian Ju, Jv;
+};
+
+[[gnu::always_inline]] inline AxisJacobians axis_jacobians(const GenericCapsuleSolution& g) {
+  return {axis_jacobian(g.attitude_a), axis_jacobian(g.attitude_b)};
 }
 
 // d^2 (e . u) / dq^2 for the unit axis u = Q(q^) e_x of the q as given: unit_quaternion.cpp's
@@ -176,26 +194,38 @@ Eigen::Matrix<double, 3, 4> axis_jacobian(const AxisAttitude& q) {
 //       [  e_y   e_z    0    -e_x ]
 // (2 M q^ is axis_gradient's J' e). With G = e . u and g = 2 (M q^ - G q^):
 //   hess = (2 M - 2 G I - 2 q^ g' - 2 g q^') / |q|^2,
-// its lower triangle times `factor` added to `K` (the upper one is not read). G is taken as
-// e . u from the axis this pass already has, where rotate_hessian forms q^' M q^ (the same on
-// the unit sphere, to rounding); UnitQuaternion itself needs the full rotation matrix and its
+// times `factor`, in units of `scale` twice (scale^2 is not formed alone: with 1 / |q|^2 up to
+// 1e80 and scale^2 as small as 2^-1200 it would underflow where the entry does not; the bracket
+// is at most a few units, so where the factor underflows the entry does). Each entry below the
+// diagonal is formed once and mirrored, so the block is exactly symmetric. G is taken as e . u
+// from the axis this pass already has, where rotate_hessian forms q^' M q^ (the same on the unit
+// sphere, to rounding); UnitQuaternion itself needs the full rotation matrix and its
 // rotation-vector map, which this pass does not build.
-inline void add_axis_hessian(const AxisAttitude& q, const Eigen::Vector3d& e, double factor,
-                             Eigen::Block<Eigen::Matrix<double, 11, 11>, 4, 4> K) {
+[[gnu::always_inline]] inline Eigen::Matrix4d axis_hessian(const AxisAttitude& q,
+                                                           const Eigen::Vector3d& e, double factor,
+                                                           double scale) {
   const double w = q.unit(0), x = q.unit(1), y = q.unit(2), z = q.unit(3);
   const double ex = e.x(), ey = e.y(), ez = e.z();
   const double G = e.dot(q.axis);
-  const Eigen::Vector4d g(
-      2.0 * (ex * w - ez * y + ey * z - G * w), 2.0 * (ex * x + ey * y + ez * z - G * x),
-      2.0 * (ey * x - ez * w - ex * y - G * y), 2.0 * (ey * w + ez * x - ex * z - G * z));
-  const double f = 2.0 * factor * q.inverse_norm * q.inverse_norm;
-  const double M_lower[10] = {ex - G, 0.0, -ez, ey, ex - G, ey, ez, -ex - G, 0.0, -ex - G};
-  int k = 0;
-  for (int j = 0; j < 4; ++j) {
-    for (int i = j; i < 4; ++i, ++k) {
-      K(i, j) += f * (M_lower[k] - q.unit(i) * g(j) - g(i) * q.unit(j));
-    }
-  }
+  const double gw = 2.0 * (ex * w - ez * y + ey * z - G * w);
+  const double gx = 2.0 * (ex * x + ey * y + ez * z - G * x);
+  const double gy = 2.0 * (ey * x - ez * w - ex * y - G * y);
+  const double gz = 2.0 * (ey * w + ez * x - ex * z - G * z);
+  const double f = 2.0 * factor * q.inverse_norm * q.inverse_norm * scale * scale;
+  const auto entry = [f](double m, double qi, double gj, double gi, double qj) {
+    return f * (m - qi * gj - gi * qj);
+  };
+  const double ww = entry(ex - G, w, gw, gw, w), xw = entry(0.0, x, gw, gx, w),
+               yw = entry(-ez, y, gw, gy, w), zw = entry(ey, z, gw, gz, w),
+               xx = entry(ex - G, x, gx, gx, x), yx = entry(ey, y, gx, gy, x),
+               zx = entry(ez, z, gx, gz, x), yy = entry(-ex - G, y, gy, gy, y),
+               zy = entry(0.0, z, gy, gz, y), zz = entry(-ex - G, z, gz, gz, z);
+  Eigen::Matrix4d hessian;
+  hessian << ww, xw, yw, zw,  //
+      xw, xx, yx, zx,         //
+      yw, yx, yy, zy,         //
+      zw, zx, zy, zz;
+  return hessian;
 }
 
 // Translating both capsules together moves nothing but the points, so phi and D depend on the
@@ -215,30 +245,42 @@ using ReducedRow = Eigen::Matrix<double, 1, 11>;
 // kept: taking them as 1 and 0, a hostile review measured ds, dt off by ~1e-13 (1 / sin^2 times
 // the axes' rounding). (The implicit function theorem of point_motion.hpp for this case in
 // closed form.)
+// a's and b's quaternion parts are e' Ju and e' Jv for the vectors e below.
+struct RateVectors {
+  Eigen::Vector3d a_qa, a_qb, b_qa, b_qb;
+};
+
+[[gnu::always_inline]] inline RateVectors rate_vectors(const GenericCapsuleSolution& g) {
+  const Eigen::Vector3d& u = g.attitude_a.axis;
+  const Eigen::Vector3d& v = g.attitude_b.axis;
+  return {g.D + g.s * u, -g.t * u, g.s * v, g.D - g.t * v};
+}
+
 struct FreeMotion {
-  Eigen::Matrix<double, 3, 4> Ju, Jv;
-  ReducedRow a, b;    // d(u . D)/dy and d(v . D)/dy with s and t held
   ReducedRow ds, dt;  // ds/dy, dt/dy
 };
 
-[[gnu::always_inline]] inline FreeMotion free_motion(const GenericCapsuleSolution& g) {
+[[gnu::always_inline]] inline FreeMotion free_motion(const GenericCapsuleSolution& g,
+                                                     const AxisJacobians& J) {
   const Eigen::Vector3d& u = g.attitude_a.axis;
   const Eigen::Vector3d& v = g.attitude_b.axis;
+  struct {
+    ReducedRow a, b;  // d(u . D)/dy and d(v . D)/dy with s and t held
+  } r;
+  const RateVectors e = rate_vectors(g);
+  r.a << u.transpose(), axis_rate(J.Ju, e.a_qa), axis_rate(J.Jv, e.a_qb);
+  r.b << v.transpose(), axis_rate(J.Ju, e.b_qa), axis_rate(J.Jv, e.b_qb);
   FreeMotion m;
-  m.Ju = axis_jacobian(g.attitude_a);
-  m.Jv = axis_jacobian(g.attitude_b);
-  m.a << u.transpose(), (g.D + g.s * u).transpose() * m.Ju, -g.t * (u.transpose() * m.Jv);
-  m.b << v.transpose(), g.s * (v.transpose() * m.Ju), (g.D - g.t * v).transpose() * m.Jv;
   if (g.s_free && g.t_free) {
     const double inverse_sin2 = 1.0 / g.sin2;
-    m.ds = (g.cos * m.b - v.squaredNorm() * m.a) * inverse_sin2;
-    m.dt = (u.squaredNorm() * m.b - g.cos * m.a) * inverse_sin2;
+    m.ds = (g.cos * r.b - v.squaredNorm() * r.a) * inverse_sin2;
+    m.dt = (u.squaredNorm() * r.b - g.cos * r.a) * inverse_sin2;
   } else if (g.s_free) {
-    m.ds = -m.a / u.squaredNorm();
+    m.ds = -r.a / u.squaredNorm();
     m.dt.setZero();
   } else if (g.t_free) {
     m.ds.setZero();
-    m.dt = m.b / v.squaredNorm();
+    m.dt = r.b / v.squaredNorm();
   } else {
     m.ds.setZero();
     m.dt.setZero();
@@ -278,22 +320,23 @@ struct PointsMotion {
 };
 
 [[gnu::always_inline]] inline PointsMotion points_motion(const GenericCapsuleSolution& g,
-                                                         const FreeMotion& m, const Capsule& a,
+                                                         const AxisJacobians& J, const Capsule& a,
                                                          const Capsule& b,
                                                          const Eigen::Vector3d& n) {
   const Eigen::Vector3d& u = g.attitude_a.axis;
   const Eigen::Vector3d& v = g.attitude_b.axis;
+  const FreeMotion m = free_motion(g, J);
   PointsMotion motion;
   Eigen::Matrix<double, 6, 11>& core = motion.core;
   core.topRows<3>() = u * m.ds;
-  core.block<3, 4>(0, 3) += g.s * m.Ju;
+  core.block<3, 4>(0, 3) += g.s * J.Ju;
   core.bottomRows<3>() = v * m.dt;
-  core.block<3, 4>(3, 7) += g.t * m.Jv;
+  core.block<3, 4>(3, 7) += g.t * J.Jv;
   Eigen::Matrix<double, 3, 11> dn;
   if (g.edge_normal) {
     dn.leftCols<3>().setZero();
-    dn.middleCols<4>(3) = -skew(v) * m.Ju;  // d(u x v) = du x v + u x dv
-    dn.rightCols<4>() = skew(u) * m.Jv;
+    dn.middleCols<4>(3) = -skew(v) * J.Ju;  // d(u x v) = du x v + u x dv
+    dn.rightCols<4>() = skew(u) * J.Jv;
     const double sign = n.dot(g.n) > 0.0 ? 1.0 : -1.0;
     dn = (dn - n * (n.transpose() * dn)) * (sign / std::sqrt(g.sin2));
   } else {
@@ -311,47 +354,73 @@ struct PointsMotion {
 // E = dD/dy with s, t held = [I, s Ju, -t Jv]:
 //   H = f_yy + f_y,xi dxi/dy,
 //   f_yy / 2 = E'E + blockdiag(0, s hess_qa (D . u), -t hess_qb (D . v))   (D held),
-//   f_y,xi dxi/dy / 2 = a' ds - b' dt   (f_xi = 2 [u . D, -v . D], whose y rates are 2 a, -2 b).
-// The last term is symmetric, -(a'a (v . v) + b'b (u . u) - cos (a'b + b'a)) / sin^2 with both
-// free, -a'a / (u . u) or -b'b / (v . v) with one; its computed lower triangle is mirrored, so H
-// is exactly symmetric. Spread over x: the r_a, r_b rows and columns are the w ones with the
-// signs of d/dr_a = d/dw, d/dr_b = -d/dw; entries with one quaternion index are multiplied by
-// scale, with two by scale twice (one product each: scale^2 alone is subnormal below 2^-511).
+//   f_y,xi dxi/dy / 2 = a ds' - b dt'   (f_xi = 2 [u . D, -v . D], whose y rates are 2 a, -2 b).
+// The last term is a negative semidefinite form of rank at most two in a and b. Both free, by
+// free_motion's ds and dt it is -(vv a a' - cos (a b' + b a') + uu b b') / sin^2 (uu = u . u,
+// vv = v . v), and completing the square with sin^2 = uu vv - cos^2 (Lagrange's identity),
+//   -(c1 c1' + c2 c2'),  c1 = (a - (cos / vv) b) sqrt(vv / sin^2),  c2 = b / sqrt(vv);
+// s alone it is -a a' / uu (c1 = a / sqrt(uu)), t alone -b b' / vv (c1 = b / sqrt(vv)), at two
+// ends 0. So H = 2 (E'E - C'C) plus the two axis Hessians, with C the rows c1, c2: a Gram matrix
+// of at most five rows, which symmetric_gram.hpp forms in vector registers, exactly symmetric.
+// Each row's quaternion parts are e' Ju and e' Jv for one vector e each (a and b are linear in
+// the vectors D + s u, s v, -t u, D - t v, and c1, c2 combinations of them), so no row over y
+// is formed first. (Written with ds and dt, entry by entry over the lower triangle, it took
+// ~115 ns of the ~260 ns query; BENCHMARKS.md.)
+// The rows are spread over x = [r_a q_a r_b q_b] before the product: d/dr_a = d/dw,
+// d/dr_b = -d/dw, and the quaternion entries are multiplied by scale, so that each product
+// carries the inputs' units (r-r entries none, r-q one scale, q-q two, one product each: scale^2
+// alone is subnormal below 2^-511), and H is written in place with no spreading afterwards.
 inline Eigen::Matrix<double, 14, 14> capsule_phi_hessian(const GenericCapsuleSolution& g,
-                                                         const FreeMotion& m) {
-  Eigen::Matrix<double, 3, 11> E;
-  E << Eigen::Matrix3d::Identity(), g.s * m.Ju, -g.t * m.Jv;
-  // The lower triangle (ds, dt are zero where held), entry by entry: Eigen's products of these
-  // shapes are not inlined here, and its 11 x 3 x 11 one takes the general matrix product
-  // (~100 ns). Skipping E'E's known blocks (I, Ea', Eb') measured no faster.
-  Eigen::Matrix<double, 11, 11> K;
-  for (int j = 0; j < 11; ++j) {
-    for (int i = j; i < 11; ++i) {
-      K(i, j) = E(0, i) * E(0, j) + E(1, i) * E(1, j) + E(2, i) * E(2, j) + m.a(i) * m.ds(j) -
-                m.b(i) * m.dt(j);
+                                                         const AxisJacobians& J) {
+  const double scale = g.scale;
+  // The row over x whose parts over y = [w q_a q_b] are [w, qa, qb].
+  const auto set_row = [scale](double* row, const Eigen::Vector3d& w, const Eigen::RowVector4d& qa,
+                               const Eigen::RowVector4d& qb) {
+    for (int i = 0; i < 3; ++i) {
+      row[i] = w(i);
+      row[7 + i] = -w(i);
     }
-  }
-  add_axis_hessian(g.attitude_a, g.D, g.s, K.block<4, 4>(3, 3));
-  add_axis_hessian(g.attitude_b, g.D, -g.t, K.block<4, 4>(7, 7));
-  // Twice K, its lower triangle mirrored, the quaternion rows and columns in the inputs' units.
-  for (int j = 0; j < 11; ++j) {
-    const double column_unit = j < 3 ? 2.0 : 2.0 * g.scale;
-    for (int i = j; i < 11; ++i) {
-      const double entry = i < 3 ? K(i, j) * column_unit : K(i, j) * column_unit * g.scale;
-      K(i, j) = K(j, i) = entry;
+    for (int i = 0; i < 4; ++i) {
+      row[3 + i] = qa(i) * scale;
+      row[10 + i] = qb(i) * scale;
     }
+    row[14] = row[15] = 0.0;
+  };
+  // ... and [w, e_a' Ju, e_b' Jv].
+  const auto set_rate_row = [&](double* row, const Eigen::Vector3d& w, const Eigen::Vector3d& e_a,
+                                const Eigen::Vector3d& e_b) {
+    set_row(row, w, axis_rate(J.Ju, e_a), axis_rate(J.Jv, e_b));
+  };
+  const Eigen::Vector3d& u = g.attitude_a.axis;
+  const Eigen::Vector3d& v = g.attitude_b.axis;
+  GramRows rows;
+  for (int k = 0; k < 3; ++k) {  // E's rows
+    set_row(rows.plus[k], Eigen::Vector3d::Unit(k), g.s * J.Ju.row(k), -g.t * J.Jv.row(k));
   }
-  // Column x_j of H is column y_j of K spread over the rows [w q_a -w q_b], negated for r_b.
+  const auto [a_qa, a_qb, b_qa, b_qb] = rate_vectors(g);
+  if (g.s_free && g.t_free) {
+    const double vv = v.squaredNorm(), root_vv = std::sqrt(vv);
+    const double ratio = g.cos / vv, c1_factor = root_vv / std::sqrt(g.sin2);
+    set_rate_row(rows.minus[0], (u - ratio * v) * c1_factor, (a_qa - ratio * b_qa) * c1_factor,
+                 (a_qb - ratio * b_qb) * c1_factor);
+    set_rate_row(rows.minus[1], v / root_vv, b_qa / root_vv, b_qb / root_vv);
+    rows.minus_count = 2;
+  } else if (g.s_free) {
+    const double root_uu = std::sqrt(u.squaredNorm());
+    set_rate_row(rows.minus[0], u / root_uu, a_qa / root_uu, a_qb / root_uu);
+    rows.minus_count = 1;
+  } else if (g.t_free) {
+    const double root_vv = std::sqrt(v.squaredNorm());
+    set_rate_row(rows.minus[0], v / root_vv, b_qa / root_vv, b_qb / root_vv);
+    rows.minus_count = 1;
+  } else {
+    rows.minus_count = 0;
+  }
   Eigen::Matrix<double, 14, 14> H;
-  for (int j = 0; j < 14; ++j) {
-    const int column = j < 7 ? j : (j < 10 ? j - 7 : j - 3);
-    const double sign = j >= 7 && j < 10 ? -1.0 : 1.0;
-    const auto k = K.col(column);
-    H.block<3, 1>(0, j) = sign * k.head<3>();
-    H.block<4, 1>(3, j) = sign * k.segment<4>(3);
-    H.block<3, 1>(7, j) = -sign * k.head<3>();
-    H.block<4, 1>(10, j) = sign * k.tail<4>();
-  }
+  symmetric_gram(rows, H.data());
+  // 2 f_yy's axis blocks, q-q entries: in units of scale twice.
+  H.block<4, 4>(3, 3) += axis_hessian(g.attitude_a, g.D, 2.0 * g.s, scale);
+  H.block<4, 4>(10, 10) += axis_hessian(g.attitude_b, g.D, -2.0 * g.t, scale);
   return H;
 }
 
@@ -376,7 +445,7 @@ ProximityJacobian generic_capsule_proximity_jacobian(const GenericCapsuleSolutio
                                                      const Capsule& a, const Pose& pose_a,
                                                      const Capsule& b, const Pose& pose_b) {
   const Proximity first = generic_proximity(solution, a, pose_a, b, pose_b);
-  const PointsMotion motion = points_motion(solution, free_motion(solution), a, b, first.normal);
+  const PointsMotion motion = points_motion(solution, axis_jacobians(solution), a, b, first.normal);
   return {first, point_columns(motion.core, solution.scale),
           point_columns(motion.surface, solution.scale)};
 }
@@ -385,11 +454,18 @@ ProximityHessian generic_capsule_proximity_hessian(const GenericCapsuleSolution&
                                                    const Capsule& a, const Pose& pose_a,
                                                    const Capsule& b, const Pose& pose_b) {
   const Proximity first = generic_proximity(solution, a, pose_a, b, pose_b);
-  const FreeMotion free_coordinates = free_motion(solution);
-  const PointsMotion motion = points_motion(solution, free_coordinates, a, b, first.normal);
+  const AxisJacobians jacobians = axis_jacobians(solution);
+  const PointsMotion motion = points_motion(solution, jacobians, a, b, first.normal);
   return {{first, point_columns(motion.core, solution.scale),
            point_columns(motion.surface, solution.scale)},
-          capsule_phi_hessian(solution, free_coordinates)};
+          capsule_phi_hessian(solution, jacobians)};
+}
+
+ProximityWithHessian generic_capsule_proximity_with_hessian(const GenericCapsuleSolution& solution,
+                                                            const Capsule& a, const Pose& pose_a,
+                                                            const Capsule& b, const Pose& pose_b) {
+  return {generic_proximity(solution, a, pose_a, b, pose_b),
+          capsule_phi_hessian(solution, axis_jacobians(solution))};
 }
 
 }  // namespace diffpills::detail

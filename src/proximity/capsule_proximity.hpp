@@ -1,6 +1,7 @@
-// proximity(), proximity_jacobian() and proximity_hessian() of two capsules in one pass (issues 12
-// and 13): the generic case without the general pipeline's pair frame object, posed cores,
-// rotation matrices, feature-based normal and general implicit-function-theorem solve.
+// proximity(), proximity_jacobian(), proximity_hessian() and proximity_with_hessian() of two
+// capsules in one pass (issues 12 and 13): the generic case without the general pipeline's pair
+// frame object, posed cores, rotation matrices, feature-based normal and general
+// implicit-function-theorem solve.
 //
 // The general pipeline (proximity.cpp) builds both cores' 3 x 3 rotations and quaternion
 // Jacobians, hands the closest points to the shared result builder as body points with free
@@ -73,17 +74,21 @@ bool solve_generic_capsules(const Capsule& a, const Pose& pose_a, const Capsule&
 
 // The results of a generic case's solution, with the closest points' Jacobians (the implicit
 // function theorem's system has at most two free coordinates, s and t along the axes, solved in
-// closed form) and with phi's Hessian (the second-order theorem over the same coordinates). Both
-// repeat generic_capsule_proximity's Proximity part bit for bit, and the Hessian the Jacobian's
-// part. Returned by value, built in place: each large matrix is a prvalue of the aggregate's
-// initializer, so the default member initializers never zero them first (~30 ns for the
-// Jacobians, ~45 ns with the Hessian, measured).
+// closed form) and with phi's Hessian (the second-order theorem over the same coordinates, a Gram
+// matrix of at most five rows: symmetric_gram.hpp), or with the Hessian alone. All repeat
+// generic_capsule_proximity's Proximity part bit for bit, the Hessian the Jacobian's part, and
+// the Hessian alone the Hessian. Returned by value, built in place: each large matrix is a
+// prvalue of the aggregate's initializer, so the default member initializers never zero them
+// first (~30 ns for the Jacobians, ~45 ns with the Hessian, measured).
 ProximityJacobian generic_capsule_proximity_jacobian(const GenericCapsuleSolution& solution,
                                                      const Capsule& a, const Pose& pose_a,
                                                      const Capsule& b, const Pose& pose_b);
 ProximityHessian generic_capsule_proximity_hessian(const GenericCapsuleSolution& solution,
                                                    const Capsule& a, const Pose& pose_a,
                                                    const Capsule& b, const Pose& pose_b);
+ProximityWithHessian generic_capsule_proximity_with_hessian(const GenericCapsuleSolution& solution,
+                                                            const Capsule& a, const Pose& pose_a,
+                                                            const Capsule& b, const Pose& pose_b);
 
 // Every field by the general pipeline, whatever the case: what the fused pass is checked against
 // (tests, fuzz_proximity). Defined in proximity.cpp.

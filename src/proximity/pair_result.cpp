@@ -147,4 +147,19 @@ ProximityHessian make_proximity_hessian(const PairFrame& frame, const Pose& pose
   return result;
 }
 
+// make_proximity_hessian's Proximity and Hessian without the points' Jacobians: phi's Hessian
+// needs only the core points' motion, not the normal's motion or the 6 x 14 matrices.
+ProximityWithHessian make_proximity_with_hessian(const PairFrame& frame, const Pose& pose_a,
+                                                 const PosedCore& a, const ClosestFeature& side_a,
+                                                 const Pose& pose_b, const PosedCore& b,
+                                                 const ClosestFeature& side_b) {
+  ProximityWithHessian result;
+  static_cast<Proximity&>(result) = make_proximity(frame, pose_a, a, side_a, pose_b, b, side_b);
+  if (!result.cores_intersect) {
+    phi_hessian(frame.scale, a, side_a, b, side_b, core_point_motion(a, side_a, b, side_b),
+                result.hessian);
+  }
+  return result;
+}
+
 }  // namespace diffpills::detail

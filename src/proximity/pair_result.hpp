@@ -26,5 +26,9 @@ ProximityHessian make_proximity_hessian(const PairFrame& frame, const Pose& pose
                                         const PosedCore& a, const ClosestFeature& side_a,
                                         const Pose& pose_b, const PosedCore& b,
                                         const ClosestFeature& side_b);
+ProximityWithHessian make_proximity_with_hessian(const PairFrame& frame, const Pose& pose_a,
+                                                 const PosedCore& a, const ClosestFeature& side_a,
+                                                 const Pose& pose_b, const PosedCore& b,
+                                                 const ClosestFeature& side_b);
 
 }  // namespace diffpills::detail

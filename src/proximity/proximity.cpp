@@ -66,8 +66,8 @@ Sides reference_sides(const ShapeA& a, const PosedCore& pa, const ShapeB& b, con
   return sides;
 }
 
-// Result is Proximity, ProximityJacobian or ProximityHessian; everything but the last step is
-// shared.
+// Result is Proximity, ProximityJacobian, ProximityHessian or ProximityWithHessian; everything
+// but the last step is shared.
 template <class Result, class ShapeA, class ShapeB>
 Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& pose_b,
              const ProximityOptions& options) {
@@ -78,7 +78,10 @@ Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& p
   const Sides sides = options.method == Method::kInteriorPoint
                           ? reference_sides(a, posed_a, b, posed_b, frame)
                           : detail::fast_sides(a, posed_a, b, posed_b, frame);
-  if constexpr (std::is_same_v<Result, ProximityHessian>) {
+  if constexpr (std::is_same_v<Result, ProximityWithHessian>) {
+    return detail::make_proximity_with_hessian(frame, pose_a, posed_a, sides[0], pose_b, posed_b,
+                                               sides[1]);
+  } else if constexpr (std::is_same_v<Result, ProximityHessian>) {
     return detail::make_proximity_hessian(frame, pose_a, posed_a, sides[0], pose_b, posed_b,
                                           sides[1]);
   } else if constexpr (std::is_same_v<Result, ProximityJacobian>) {
@@ -169,6 +172,23 @@ ProximityHessian proximity_hessian(const Shape& a, const Pose& pose_a, const Sha
   return std::visit(
       [&](const auto& shape_a, const auto& shape_b) {
         return query<ProximityHessian>(shape_a, pose_a, shape_b, pose_b, options);
+      },
+      a, b);
+}
+
+ProximityWithHessian proximity_with_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
+                                            const Pose& pose_b, const ProximityOptions& options) {
+  const Capsule* capsule_a = std::get_if<Capsule>(&a);
+  const Capsule* capsule_b = std::get_if<Capsule>(&b);
+  detail::GenericCapsuleSolution solution;
+  if (options.method == Method::kDefault && capsule_a != nullptr && capsule_b != nullptr &&
+      detail::solve_generic_capsules(*capsule_a, pose_a, *capsule_b, pose_b, solution)) {
+    return detail::generic_capsule_proximity_with_hessian(solution, *capsule_a, pose_a, *capsule_b,
+                                                          pose_b);
+  }
+  return std::visit(
+      [&](const auto& shape_a, const auto& shape_b) {
+        return query<ProximityWithHessian>(shape_a, pose_a, shape_b, pose_b, options);
       },
       a, b);
 }
