@@ -22,7 +22,7 @@
 //   - second order and shapes (one pair in two): proximity_hessian and signed_distance_hessian
 //     repeat the first-order answer bit for bit (the Jacobians too) and give a finite, exactly
 //     symmetric Hessian (and a finite normal Jacobian), which proximity_with_hessian repeats
-//     bit for bit with its Proximity; two capsules' Hessian agrees with the
+//     with its Proximity (every field ==); two capsules' Hessian agrees with the
 //     general pipeline's; the shape gradients are finite, with a row per given row and the same
 //     phi / distance as the plain calls.
 #include <fuzzer/FuzzedDataProvider.h>
@@ -336,7 +336,8 @@ void check_second_order(const Shape& a, const Pose& pose_a, const Shape& b, cons
       diffpills::proximity_with_hessian(a, pose_a, b, pose_b);
   check(lean.phi == hessian.phi && lean.gradient == hessian.gradient &&
             lean.normal == hessian.normal && lean.points == hessian.points &&
-            lean.hessian == hessian.hessian,
+            lean.core_points == hessian.core_points &&
+            lean.cores_intersect == hessian.cores_intersect && lean.hessian == hessian.hessian,
         "proximity_with_hessian repeats proximity_hessian", lean.phi - hessian.phi);
 
   const diffpills::SignedDistanceJacobian first =

@@ -193,6 +193,33 @@ TEST(CapsuleProximity, HessianOnEveryInstructionSet) {
   hwy::SetSupportedTargetsForTest(0);
 }
 
+// The axis Hessian's factor, 1 / |q|^2 times a short capsule's s times scale^2, leaves the
+// normal range in its parts where the entry does not (a hostile review: |q| = 1e100 and a capsule
+// 1e-25 long in a 1e99 scene lost its q-q block). Scaling q by 1e100 scales that block by
+// 1e-200 exactly in real numbers; the fused pass must keep it to rounding.
+TEST(CapsuleProximity, AxisHessianOfAHugeQuaternionKeepsItsDigits) {
+  const double c = std::sqrt(0.5);
+  for (const double length : {1e-15, 1e-25, 1e-40}) {
+    const Capsule a(length, 0.0), b(1e99, 0.0);
+    const Pose pose_b(Eigen::Vector3d(1e98, 0, 5e98), Eigen::Vector4d(c, 0, 0, c));
+    const Pose unit(Eigen::Vector3d::Zero(), Eigen::Vector4d(1, 0, 0, 0));
+    const Pose huge(Eigen::Vector3d::Zero(), Eigen::Vector4d(1e100, 0, 0, 0));
+    ASSERT_TRUE(generic({a, b, unit, pose_b}));
+    ASSERT_TRUE(generic({a, b, huge, pose_b}));
+    const Eigen::Matrix<double, 14, 14> H1 =
+        proximity_with_hessian(Shape(a), unit, Shape(b), pose_b).hessian;
+    const Eigen::Matrix<double, 14, 14> H2 =
+        proximity_with_hessian(Shape(a), huge, Shape(b), pose_b).hessian;
+    ASSERT_NE(H1(5, 5), 0.0);
+    for (int i = 3; i < 7; ++i) {
+      for (int j = 3; j < 7; ++j) {
+        EXPECT_NEAR(H2(i, j), H1(i, j) * 1e-200, 1e-12 * std::abs(H1(5, 5)) * 1e-200)
+            << "length " << length << ", entry " << i << ", " << j;
+      }
+    }
+  }
+}
+
 // Central differences of phi in every position coordinate and every raw quaternion component
 // (the gradient refers to q as given, normalization included).
 TEST(CapsuleProximity, GradientMatchesCentralDifferences) {

@@ -37,11 +37,11 @@ inline std::string not_constructed(const py::handle& object) {
   const std::string type = py::str(py::type::of(object).attr("__name__"));
   return "this diffpills." + type + " was made by __new__ without __init__ and holds no value; " +
          (py::isinstance<Proximity>(object)
-              ? "results come from diffpills.proximity, proximity_jacobian and "
-                "proximity_shape_gradient"
+              ? "results come from diffpills.proximity, proximity_jacobian, proximity_hessian, "
+                "proximity_with_hessian and proximity_shape_gradient"
           : py::isinstance<SignedDistance>(object)
-              ? "results come from diffpills.signed_distance, signed_distance_jacobian and "
-                "signed_distance_shape_gradient"
+              ? "results come from diffpills.signed_distance, signed_distance_jacobian, "
+                "signed_distance_hessian and signed_distance_shape_gradient"
               : "create it as diffpills." + type + "(...)");
 }
 

@@ -194,9 +194,12 @@ struct AxisJacobians {
 //       [  e_y   e_z    0    -e_x ]
 // (2 M q^ is axis_gradient's J' e). With G = e . u and g = 2 (M q^ - G q^):
 //   hess = (2 M - 2 G I - 2 q^ g' - 2 g q^') / |q|^2,
-// times `factor`, in units of `scale` twice (scale^2 is not formed alone: with 1 / |q|^2 up to
-// 1e80 and scale^2 as small as 2^-1200 it would underflow where the entry does not; the bracket
-// is at most a few units, so where the factor underflows the entry does). Each entry below the
+// times `factor`, in units of `scale` twice. 1 / |q| is multiplied by the scale first: 1 / |q|^2
+// spans [2.5e-201, 1e80] and scale^2 [2^-2000, 2^666], so either squared alone, or factor / |q|^2
+// for a small factor (a short capsule's s), may leave the normal range where the entry does not
+// (a hostile review: |q| = 1e100 and s = 1e-25 of a 1e99 scene lost the block); (1 / |q|) scale
+// is within the inputs' range, and the bracket is at most a few units, so where f underflows the
+// entry does. Each entry below the
 // diagonal is formed once and mirrored, so the block is exactly symmetric. G is taken as e . u
 // from the axis this pass already has, where rotate_hessian forms q^' M q^ (the same on the unit
 // sphere, to rounding); UnitQuaternion itself needs the full rotation matrix and its
@@ -211,7 +214,8 @@ struct AxisJacobians {
   const double gx = 2.0 * (ex * x + ey * y + ez * z - G * x);
   const double gy = 2.0 * (ey * x - ez * w - ex * y - G * y);
   const double gz = 2.0 * (ey * w + ez * x - ex * z - G * z);
-  const double f = 2.0 * factor * q.inverse_norm * q.inverse_norm * scale * scale;
+  const double unit = q.inverse_norm * scale;  // 1 / |q| in the frame's lengths
+  const double f = 2.0 * factor * unit * unit;
   const auto entry = [f](double m, double qi, double gj, double gi, double qj) {
     return f * (m - qi * gj - gi * qj);
   };
@@ -234,6 +238,18 @@ struct AxisJacobians {
 // (d/dr_a = d/dw, d/dr_b = -d/dw), the quaternion columns multiplied by scale.
 using ReducedRow = Eigen::Matrix<double, 1, 11>;
 
+// The rates a and b below (free_motion's) have quaternion parts e' Ju and e' Jv for the vectors e
+// here.
+struct RateVectors {
+  Eigen::Vector3d a_qa, a_qb, b_qa, b_qb;
+};
+
+[[gnu::always_inline]] inline RateVectors rate_vectors(const GenericCapsuleSolution& g) {
+  const Eigen::Vector3d& u = g.attitude_a.axis;
+  const Eigen::Vector3d& v = g.attitude_b.axis;
+  return {g.D + g.s * u, -g.t * u, g.s * v, g.D - g.t * v};
+}
+
 // How the free coordinates move. With D = w + s u(q_a) - t v(q_b), a free s (strictly inside its
 // segment) keeps u . D = 0 and a free t keeps v . D = 0. Differentiating,
 //   d(u . D) = a + (u . u) ds - cos dt,  a = [u', (D + s u)' Ju, -t u' Jv],
@@ -245,17 +261,6 @@ using ReducedRow = Eigen::Matrix<double, 1, 11>;
 // kept: taking them as 1 and 0, a hostile review measured ds, dt off by ~1e-13 (1 / sin^2 times
 // the axes' rounding). (The implicit function theorem of point_motion.hpp for this case in
 // closed form.)
-// a's and b's quaternion parts are e' Ju and e' Jv for the vectors e below.
-struct RateVectors {
-  Eigen::Vector3d a_qa, a_qb, b_qa, b_qb;
-};
-
-[[gnu::always_inline]] inline RateVectors rate_vectors(const GenericCapsuleSolution& g) {
-  const Eigen::Vector3d& u = g.attitude_a.axis;
-  const Eigen::Vector3d& v = g.attitude_b.axis;
-  return {g.D + g.s * u, -g.t * u, g.s * v, g.D - g.t * v};
-}
-
 struct FreeMotion {
   ReducedRow ds, dt;  // ds/dy, dt/dy
 };
@@ -438,9 +443,9 @@ bool solve_generic_capsules(const Capsule& a, const Pose& pose_a, const Capsule&
   return solve_generic(a, pose_a, b, pose_b, solution);
 }
 
-// The Jacobian's and the Hessian's first three steps are written out in both: gathered in one
-// helper returning a struct of them, the points' motion was copied into it, and the Jacobian
-// took 181 ns instead of 159.
+// The Jacobian's and the Hessians' first steps are written out in each: gathered in one helper
+// returning a struct of them, the points' motion was copied into it, and the Jacobian took 181 ns
+// instead of 159.
 ProximityJacobian generic_capsule_proximity_jacobian(const GenericCapsuleSolution& solution,
                                                      const Capsule& a, const Pose& pose_a,
                                                      const Capsule& b, const Pose& pose_b) {

@@ -4,6 +4,12 @@
 #define HWY_TARGET_INCLUDE "proximity/symmetric_gram.cpp"
 #include "symmetric_gram.hpp"
 
+// The kernel keeps the rows in arrays of vectors whose number it knows at compile time: not
+// compiled for Highway's scalable targets, whose vectors are sizeless and of run-time length.
+#include <hwy/detect_targets.h>
+#undef HWY_DISABLED_TARGETS
+#define HWY_DISABLED_TARGETS (HWY_SVE | HWY_SVE2 | HWY_SVE_256 | HWY_SVE2_128 | HWY_RVV)
+
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
@@ -19,10 +25,11 @@ namespace hn = hwy::HWY_NAMESPACE;
 // vectors of kLanes lanes (1, 2, 4 or 8: 14 rows are 7 x 2, 3 x 4 + 2 or 8 + 6), the rows held in
 // registers across the columns. Lane i of column j multiplies the same two numbers as lane j of
 // column i and accumulates in the same order (plus_0, plus_1, plus_2, then the minus rows; a fused
-// multiply-add's product is exact, so it is the same either way round): H(i, j) and H(j, i) have
-// the same bits. Columns 7-9 are columns 0-2 negated, exactly (entries 7-9 of every row are
-// entries 0-2 negated: the capsule Hessian's r_b = -r_a, capsule_proximity.cpp), so they are not
-// computed again. A vector reaching past row 13 is stored with a mask.
+// multiply-add's product is exact, so it is the same either way round): H(i, j) == H(j, i)
+// exactly. Columns 7-9 are columns 0-2 negated, exactly (entries 7-9 of every row are entries 0-2
+// negated: the capsule Hessian's r_b = -r_a, capsule_proximity.cpp), so they are not computed
+// again; a zero there may be -0 where its mirror image, computed, is +0. A vector reaching past
+// row 13 is stored with a mask.
 template <int kMinus>
 HWY_INLINE void Gram(const GramRows& rows, double* HWY_RESTRICT out) {
   const hn::ScalableTag<double> d;

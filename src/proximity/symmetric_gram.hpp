@@ -5,8 +5,9 @@
 //
 // from three rows `plus` and at most two rows `minus` of 14 entries each, computed a column at a
 // time in the widest vectors the CPU runs (Google Highway with run-time dispatch, as the capsule
-// batches' kernel: AVX-512, AVX2, SSE4, or plain code). Entry (i, j) is formed from the same
-// products in the same order as entry (j, i), so H is exactly symmetric on every instruction set;
+// batches' kernel: AVX-512, AVX2, SSE4, SSSE3 or plain code; fixed-width vectors only, not
+// Highway's SVE or RVV targets). Entry (i, j) is formed from the same products in the same order
+// as entry (j, i), so H is exactly symmetric (==, a zero's sign aside) on every instruction set;
 // the last bits of an entry may differ between instruction sets (fused multiply-adds).
 #pragma once
 
