@@ -114,9 +114,10 @@ void run_with_hessian(benchmark::State& state, const A& a, const B& b) {
   }
 }
 
-// proximity_with_hessian of two capsules with the Hessian's vector kernel (symmetric_gram.hpp)
-// held to each instruction set this CPU runs (Highway's targets, widest first), labelled.
-void CapsuleCapsule_WithHessian_InstructionSet(benchmark::State& state) {
+// `run` with the library's vector kernels held to the instruction set indexed by the benchmark's
+// argument among those this CPU runs (Highway's targets, widest first), labelled with its name.
+template <class Run>
+void on_instruction_set(benchmark::State& state, const Run& run) {
   const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
   const auto index = static_cast<std::size_t>(state.range(0));
   if (index >= targets.size()) {
@@ -125,8 +126,17 @@ void CapsuleCapsule_WithHessian_InstructionSet(benchmark::State& state) {
   }
   hwy::SetSupportedTargetsForTest(targets[index]);
   state.SetLabel(hwy::TargetName(targets[index]));
-  run_with_hessian(state, kCapsuleA, kCapsuleB);
+  run();
   hwy::SetSupportedTargetsForTest(0);
+}
+
+// proximity_with_hessian of two capsules (the Hessian's Gram matrix, symmetric_gram.hpp) and
+// proximity of two hexagons (the edge pairs' bounds, segment_bounds.hpp) on each instruction set.
+void CapsuleCapsule_WithHessian_InstructionSet(benchmark::State& state) {
+  on_instruction_set(state, [&] { run_with_hessian(state, kCapsuleA, kCapsuleB); });
+}
+void HexagonHexagon_Proximity_InstructionSet(benchmark::State& state) {
+  on_instruction_set(state, [&] { run_proximity(state, kHexagonA, kHexagonB, Method::kDefault); });
 }
 
 // FCL's transform of one of our poses; `capsule` adds the z-to-x axis change.
@@ -444,24 +454,17 @@ void Batch_CapsuleCapsule_SignedDistance(benchmark::State& s) {
 // The capsule batch on one thread with the vector kernel held to each instruction set this CPU
 // runs (Highway's targets, widest first: the argument indexes them), labelled with its name.
 void Batch_CapsuleCapsule_InstructionSet(benchmark::State& state) {
-  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
-  const auto index = static_cast<std::size_t>(state.range(0));
-  if (index >= targets.size()) {
-    state.SkipWithError("no such instruction set here");
-    return;
-  }
-  hwy::SetSupportedTargetsForTest(targets[index]);
-  state.SetLabel(hwy::TargetName(targets[index]));
-  const Eigen::Index count = 100000;
-  const BatchPoses& p = batch_poses(count);
-  Eigen::VectorXd phi(count);
-  GradientArray gradient(count, 14);
-  for (auto _ : state) {
-    proximity_batch(kCapsuleA, p.r_a, p.q_a, kCapsuleB, p.r_b, p.q_b, phi, gradient, {1});
-    benchmark::DoNotOptimize(phi.data());
-  }
-  hwy::SetSupportedTargetsForTest(0);
-  state.SetItemsProcessed(state.iterations() * count);
+  on_instruction_set(state, [&] {
+    const Eigen::Index count = 100000;
+    const BatchPoses& p = batch_poses(count);
+    Eigen::VectorXd phi(count);
+    GradientArray gradient(count, 14);
+    for (auto _ : state) {
+      proximity_batch(kCapsuleA, p.r_a, p.q_a, kCapsuleB, p.r_b, p.q_b, phi, gradient, {1});
+      benchmark::DoNotOptimize(phi.data());
+    }
+    state.SetItemsProcessed(state.iterations() * count);
+  });
 }
 
 // The same rows split by OpenMP (libgomp, dynamic schedule) and by oneTBB (parallel_for over
@@ -637,6 +640,7 @@ BENCHMARK(CapsuleHexagon_Hessian);
 BENCHMARK(CapsuleHexagon_WithHessian);
 BENCHMARK(HexagonHexagon_FclDistance);
 BENCHMARK(HexagonHexagon_Proximity);
+BENCHMARK(HexagonHexagon_Proximity_InstructionSet)->DenseRange(0, 4);
 BENCHMARK(HexagonHexagon_InteriorPoint);
 BENCHMARK(HexagonHexagon_Jacobian);
 BENCHMARK(HexagonHexagon_Hessian);

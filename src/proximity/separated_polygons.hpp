@@ -52,8 +52,10 @@ class CarriedPolygon {
 // W: B's vertices carried into A's frame (frame.b_in_a), X: A's into B's. The candidates (see
 // polygon_polygon.cpp): a support vertex of one over the other's face (or, for an edge parallel to
 // that face, the middle of its part over it), and every pair of edges (the middle of their overlap
-// when parallel), the pairs whose lower bound exceeds the best distance by the tolerance skipped.
-// Candidates for a whole interval win ties within the tie tolerance (pair_frame.hpp).
+// when parallel), the pairs whose lower bound exceeds the best distance by the tie band skipped
+// (the larger of the tolerance and the tie tolerance; windows too large to visit every pair, the
+// tolerance), up to 32 x 32 vertex pairs with segment_bounds.hpp's vector bounds where the CPU has
+// 4 lanes. Candidates for a whole interval win ties within the tie tolerance (pair_frame.hpp).
 std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const PolygonView& b,
                                                 const PolygonPairFrame& frame,
                                                 const CarriedPolygon<PolygonView>& W,
