@@ -191,11 +191,12 @@ json parse_json_line(const std::string& line, const std::string& expected) {
                                 ": a NUL byte (JSON text cannot hold one; in a string, write "
                                 "\\u0000)");
   }
-  json root;
-  LineBuilder builder(line, root);
+  // A line refused part way (malformed, or memory running out) is released, not destroyed.
+  Released<json> root;
+  LineBuilder builder(line, root.value);
   // nlohmann skips the byte order mark itself, so byte positions count it.
   if (!json::sax_parse(line, &builder)) throw std::invalid_argument(builder.error());
-  return root;
+  return std::move(root.value);
 }
 
 }  // namespace diffpills::app

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <cstddef>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 namespace diffpills::app {
 
@@ -22,5 +24,41 @@ constexpr std::size_t kMaxNesting = 64;
 // when the line holds such a word), a number beyond the range of a double, a key given twice in one
 // object, or nesting deeper than kMaxNesting arrays and objects.
 nlohmann::json parse_json_line(const std::string& line, const std::string& expected);
+
+// Empties `value` without allocating, so that destroying it allocates nothing either. nlohmann's
+// destructor first moves a non-empty container's children into a new vector (to free deep values
+// without recursion), and that allocation fails where memory ran out, inside a destructor: a
+// std::bad_alloc there ends the program (a hostile review: a line of 4 million numbers under
+// ulimit -v, every later line lost). Here each container is emptied from its last child, each
+// child released first, so every destructor run meets empty containers; the commands' values nest
+// at most kMaxNesting deep, so the recursion is bounded.
+template <class Json>
+void release(Json& value) noexcept {
+  if (value.is_array()) {
+    auto& items = value.template get_ref<typename Json::array_t&>();
+    while (!items.empty()) {
+      release(items.back());
+      items.pop_back();
+    }
+  } else if (value.is_object()) {
+    auto& members = value.template get_ref<typename Json::object_t&>();
+    while (!members.empty()) {
+      const auto last = std::prev(members.end());
+      release(last->second);
+      members.erase(last);
+    }
+  }
+}
+
+// A value released (above) when it goes out of scope, by any path.
+template <class Json>
+struct Released {
+  Released() = default;
+  explicit Released(Json&& json) : value(std::move(json)) {}
+  Released(const Released&) = delete;
+  Released& operator=(const Released&) = delete;
+  ~Released() { release(value); }
+  Json value;
+};
 
 }  // namespace diffpills::app

@@ -39,10 +39,13 @@ std::string error_answer(const std::string& message) { return to_line({{"error",
 
 // Reads the next line of `in` without its '\n', like std::getline, but keeps at most
 // kMaxLineBytes + 1 of its bytes and skips the rest: a line of any length costs bounded memory
-// and is still answered (as too long). Returns false at the end of the input or when reading
-// fails (then in.bad()).
-bool read_line(std::istream& in, std::string& line) {
+// and is still answered (as too long). If memory runs out while the line is kept, the rest of it
+// is skipped too and `unread` is set (the line is answered with an error; a hostile review: a
+// 60 MB line under ulimit -v ended the command). Returns false at the end of the input or when
+// reading fails (then in.bad()).
+bool read_line(std::istream& in, std::string& line, bool& unread) {
   line.clear();
+  unread = false;
   const std::istream::sentry sentry(in, /*noskipws=*/true);
   if (!sentry) return false;
   using traits = std::istream::traits_type;
@@ -51,10 +54,16 @@ bool read_line(std::istream& in, std::string& line) {
     for (auto c = buffer.sbumpc();; c = buffer.sbumpc()) {
       if (traits::eq_int_type(c, traits::eof())) {
         in.setstate(std::ios::eofbit);
-        return !line.empty();
+        return !line.empty() || unread;
       }
       if (traits::eq_int_type(c, traits::to_int_type('\n'))) return true;
-      if (line.size() <= kMaxLineBytes) line.push_back(traits::to_char_type(c));
+      if (unread || line.size() > kMaxLineBytes) continue;
+      try {
+        line.push_back(traits::to_char_type(c));
+      } catch (const std::bad_alloc&) {
+        std::string().swap(line);  // its memory back
+        unread = true;
+      }
     }
   } catch (const std::ios_base::failure&) {  // libstdc++'s file buffers throw on a read error
     in.setstate(std::ios::badbit);
@@ -80,9 +89,13 @@ std::string answer_line(const std::string& line, const std::string& expected, co
       throw std::invalid_argument("query: line longer than " + std::to_string(kMaxLineBytes) +
                                   " bytes");
     }
-    std::string result = to_line(answer(parse_json_line(line, expected)));
+    // Both values released, not destroyed, however this ends (json_line.hpp's release): a line
+    // or an answer of millions of entries would otherwise allocate as it goes.
+    const Released<nlohmann::json> query(parse_json_line(line, expected));
+    const Released<nlohmann::ordered_json> result(answer(query.value));
+    std::string text = to_line(result.value);
     ok = true;
-    return result;
+    return text;
   } catch (const std::bad_alloc&) {
     return error_answer("query: not enough memory to parse this line (" +
                         std::to_string(line.size()) + " bytes)");
@@ -98,9 +111,12 @@ int run_lines(std::istream& in, std::ostream& out, std::ostream& diagnostics,
   for (;;) {
     // errno is cleared before each read and write so that a failure's reason is its own.
     errno = 0;
-    if (!read_line(in, line)) break;
+    bool unread = false;
+    if (!read_line(in, line, unread)) break;
     bool ok = false;
-    const std::string answer_text = answer_line(line, expected, answer, ok);
+    const std::string answer_text = unread
+                                        ? error_answer("query: not enough memory to read this line")
+                                        : answer_line(line, expected, answer, ok);
     errno = 0;
     out << answer_text << '\n';
     if (!flush_standard_output(out, diagnostics)) return kInputOutputFailed;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "json_io.hpp"
+#include "json_line.hpp"
 
 namespace diffpills::app {
 namespace {
@@ -52,9 +53,11 @@ nlohmann::ordered_json answer(const json& query) {
       throw std::invalid_argument("method: must be \"default\" or \"interior_point\"");
     }
   }
-  nlohmann::ordered_json out =
+  // Released, not destroyed, if building it throws (json_line.hpp's release).
+  Released<nlohmann::ordered_json> answer(
       jacobian ? to_json(proximity_jacobian(a.shape, a.pose, b.shape, b.pose, options))
-               : to_json(proximity(a.shape, a.pose, b.shape, b.pose, options));
+               : to_json(proximity(a.shape, a.pose, b.shape, b.pose, options)));
+  nlohmann::ordered_json& out = answer.value;
   if (hessian) {
     out["hessian"] =
         matrix_rows(proximity_with_hessian(a.shape, a.pose, b.shape, b.pose, options).hessian);
@@ -76,7 +79,7 @@ nlohmann::ordered_json answer(const json& query) {
           to_json(signed_distance_shape_gradient(a.shape, a.pose, b.shape, b.pose).shape_gradient);
     }
   }
-  return out;
+  return std::move(out);
 }
 
 }  // namespace

@@ -66,11 +66,12 @@ nlohmann::ordered_json answer(const Scene& scene, double default_margin, const j
     throw std::invalid_argument("poses." + scene.body(error.body()).name() + ", shape " +
                                 std::to_string(error.shape()) + ": " + error.reason());
   }
-  nlohmann::ordered_json contacts = nlohmann::ordered_json::array();
+  // Released, not destroyed, if building it throws (json_line.hpp's release).
+  Released<nlohmann::ordered_json> contacts(nlohmann::ordered_json::array());
   for (const Contact& contact : found) {
-    contacts.push_back(to_json(contact, scene));
+    contacts.value.push_back(to_json(contact, scene));
   }
-  return {{"contacts", std::move(contacts)}};
+  return {{"contacts", std::move(contacts.value)}};
 }
 
 // The scene file, parsed as one JSON text (the limits of a query line apply to it).
@@ -87,9 +88,9 @@ Scene load_scene(const std::string& path) {
     }
   }
   if (file.bad()) throw std::invalid_argument("cannot read the scene file");
-  json value;
+  Released<json> value;  // not destroyed with an allocation (json_line.hpp's release)
   try {
-    value = parse_json_line(text, kSceneFile);
+    value.value = parse_json_line(text, kSceneFile);
   } catch (const std::bad_alloc&) {
     throw std::invalid_argument("not enough memory to parse the scene file");
   } catch (const std::invalid_argument& error) {
@@ -99,7 +100,7 @@ Scene load_scene(const std::string& path) {
     if (message.rfind("empty line", 0) == 0) message.replace(0, 10, "empty file");
     throw std::invalid_argument(message);
   }
-  return parse_scene(value);
+  return parse_scene(value.value);
 }
 
 // A margin argument: the whole argument a number as JSON writes one (the margin of a line is

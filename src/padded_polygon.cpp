@@ -20,8 +20,9 @@
 // (whose neighbours cut ~2e-9 of its size). What b cuts off is the triangle of the vertices
 // v_ab, v_ac, v_bc, measured by v_ac's distance from the edge v_ab v_bc (not from b's line: for b
 // nearly parallel to a side of a needle, the tip beyond b's line by 1e-15 can be 4.5e-5 from the
-// rest). Drops add up: a vertex may end a few 1e-12 of the size beyond a dropped row. A loose row far away (offset 1e13 beside a unit
-// square) sets nothing: the tolerance is the polygon's size, not the largest offset's.
+// rest). Drops add up: a vertex may end a few 1e-12 of the size beyond a dropped row. A loose row
+// far away (offset 1e13 beside a unit square) sets nothing: the tolerance is the polygon's size,
+// not the largest offset's.
 //
 // Bounded <=> consecutive kept normals turn by less than pi. The vertices are computed from the
 // rows as given, not from the unit normals: each row scaled by a power of two (exactly) so that
@@ -161,9 +162,12 @@ bool normalize_row(double c0, double c1, double d, UnitRow& row) {
   row.offset = d / norm;
   int exponent = 0;
   std::frexp(largest, &exponent);  // largest = f 2^exponent, f in [1/2, 1)
-  const double scale = std::ldexp(1.0, 1 - exponent);
-  row.scaled_row = Eigen::Vector2d(c0 * scale, c1 * scale);
-  row.scaled_offset = d * scale;
+  // Each value times 2^(1 - exponent), not times that power formed first: for a subnormal row
+  // (largest below 2^-1022) the power is above 2^1023, infinite, and the row was dropped as
+  // constraining nothing (a hostile review: [1e-308, 0] y <= 5e-309 ignored, a point beyond it
+  // reported touching).
+  row.scaled_row = Eigen::Vector2d(std::ldexp(c0, 1 - exponent), std::ldexp(c1, 1 - exponent));
+  row.scaled_offset = std::ldexp(d, 1 - exponent);
   return std::isfinite(row.offset) && std::isfinite(row.scaled_offset);
 }
 

@@ -46,9 +46,14 @@ PolygonShapeGradient polygon_gradient(const PaddedPolygon& polygon, const Pose& 
     const std::array<Eigen::Index, 2> edges = {j, (j + 1) % k};
     for (int side = 0; side < 2; ++side) {
       const int row = polygon.edge_rows()(edges[static_cast<std::size_t>(side)]);
-      const double lambda = mu[static_cast<std::size_t>(side)] / C.row(row).norm();
-      out.d(row) = -lambda;
-      out.C.row(row) = lambda * y.transpose();
+      // The multiplier of the row as given, mu / |C_i|: |C_i| by hypot (C.row(i).norm() squares,
+      // and a row below ~1e-154 made it 0 and the gradient infinite or NaN: a hostile review), and
+      // divided last, so that an entry beyond the largest double is +-infinity, never 0 * inf.
+      const double mu_side = mu[static_cast<std::size_t>(side)];
+      const double norm = std::hypot(C(row, 0), C(row, 1));
+      out.d(row) = -mu_side / norm;
+      out.C(row, 0) = mu_side * y.x() / norm;
+      out.C(row, 1) = mu_side * y.y() / norm;
     }
     return out;
   }

@@ -56,4 +56,22 @@ timeout 120 "$bin" query < "$work/keys" > "$work/out"
 status=$?
 [ "$status" -eq 1 ] || fail "10^6 keys: exit $status, expected 1 within 120 s"
 check_answers "$work/out" e
+
+# Memory running out is an answer too, each such line followed by a valid query: a line of 4
+# million numbers under a 100 MB limit of address space (parsed, it needs ~2 GB), and a 60 MB line
+# under 50 MB (too long to keep). A hostile review: the parsed line's destructor allocated and
+# std::bad_alloc ended the command; reading the long line did too. The command itself needs under
+# 20 MB. Not under AddressSanitizer, which reserves terabytes of address space at start.
+if ! ldd "$bin" 2>/dev/null | grep -q libasan; then
+  { python3 -c "print('{\"a\": [' + '1e5,' * 4000000 + '1]}')"; printf '%s\n' "$query"; } > "$work/numbers"
+  { head -c 60000000 /dev/zero | tr '\0' ' '; printf '\n%s\n' "$query"; } > "$work/spaces"
+  for case in "numbers 100000 parse" "spaces 50000 read"; do
+    set -- $case
+    (ulimit -v "$2"; "$bin" query < "$work/$1" > "$work/out")
+    status=$?
+    [ "$status" -eq 1 ] || fail "$1 under a memory limit: exit $status, expected 1"
+    check_answers "$work/out" er
+    grep -q "not enough memory to $3 this line" "$work/out" || fail "$1: no memory error"
+  done
+fi
 echo "cli hostile input: ok"

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "diffpills/diffpills.hpp"
@@ -231,6 +232,39 @@ TEST(ShapeGradient, SwappingTheShapesSwapsTheGradients) {
 }
 
 // Analytic cases: a unit square 2 above a sphere, and a capsule reaching past a square's edge.
+// A row given scaled by c is the same half-plane, and its multiplier, so its gradient, is 1 / c
+// times: exactly so for rows far below 1e-154 too, whose squares underflow (a hostile review:
+// |C_i| = 1e-200 gave -inf for d/dd_i, and NaN with the shapes apart), and never NaN where it
+// exceeds the largest double.
+TEST(ShapeGradient, RowsOfAnyScaleGetTheirGradient) {
+  Eigen::MatrixX2d C(4, 2);
+  C << 1, 0, 0, 1, -1, 0, 0, -1;
+  const Capsule sphere(0.0, 0.2);
+  const Pose beside(Eigen::Vector3d(2, 0.3, -0.5), Eigen::Vector4d(1, 0, 0, 0));
+  const PaddedPolygon unit(C, Eigen::Vector4d::Constant(1.0), 0.1);
+  const auto reference = std::get<PolygonShapeGradient>(
+      proximity_shape_gradient(unit, Pose(), sphere, beside).shape_gradient[0]);
+  ASSERT_NE(reference.d(0), 0.0);
+  for (const double scale : {1e-100, 1e-200, 1e-300, 1e-305}) {
+    SCOPED_TRACE(scale);
+    const PaddedPolygon tiny(scale * C, Eigen::Vector4d::Constant(scale), 0.1);
+    const auto g = std::get<PolygonShapeGradient>(
+        proximity_shape_gradient(tiny, Pose(), sphere, beside).shape_gradient[0]);
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_NEAR(g.d(i) * scale, reference.d(i), 1e-14 * std::abs(reference.d(0))) << i;
+      EXPECT_NEAR(g.C(i, 0) * scale, reference.C(i, 0), 1e-14 * std::abs(reference.d(0))) << i;
+      EXPECT_NEAR(g.C(i, 1) * scale, reference.C(i, 1), 1e-14 * std::abs(reference.d(0))) << i;
+    }
+  }
+  // Subnormal rows: the exact values exceed the largest double; infinite, not NaN.
+  const PaddedPolygon subnormal(1e-320 * C, Eigen::Vector4d::Constant(1e-320), 0.1);
+  const auto g = std::get<PolygonShapeGradient>(
+      proximity_shape_gradient(subnormal, Pose(), sphere, beside).shape_gradient[0]);
+  EXPECT_FALSE(g.d.hasNaN());
+  EXPECT_FALSE(g.C.hasNaN());
+  EXPECT_EQ(g.d(0), -std::numeric_limits<double>::infinity());
+}
+
 TEST(ShapeGradient, AnalyticCases) {
   Eigen::MatrixX2d C(5, 2);
   C << 1, 0, 0, 1, -1, 0, 0, -1, 2, 0;  // the last row is x <= 4: redundant, twice loose

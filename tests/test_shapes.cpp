@@ -133,6 +133,28 @@ TEST(Shapes, PolygonRejectsOffsetsThatUnderflow) {
   EXPECT_GT(tiny.extent(), 0.0);
 }
 
+// Rows given at any scale are the same half-planes, down to subnormal entries (a hostile review:
+// the row [1e-308, 0] y <= 5e-309, x <= 0.5, was dropped as constraining nothing, and a point at
+// x = 0.9 reported touching; a polygon of subnormal rows only, unbounded).
+TEST(Shapes, SubnormalRowsAreTheirHalfPlanes) {
+  Eigen::MatrixX2d C(5, 2);
+  C << 1, 0, 0, 1, -1, 0, 0, -1, 1e-308, 0;
+  const PaddedPolygon cut(C, (Eigen::VectorXd(5) << 1, 1, 1, 1, 5e-309).finished(), 0.0);
+  const Capsule point(0.0, 0.0);
+  const Proximity p = proximity(point, Pose({0.9, 0, 0}, {1, 0, 0, 0}), cut, Pose());
+  EXPECT_NEAR(p.phi, 0.4 * 0.4, 1e-15);
+  EXPECT_FALSE(p.cores_intersect);
+  for (const double scale : {0x1p-1030, 0x1p-1060, 1e-310}) {
+    SCOPED_TRACE(scale);
+    Eigen::MatrixX2d square(4, 2);
+    square << 1, 0, 0, 1, -1, 0, 0, -1;
+    const PaddedPolygon tiny_rows(scale * square, Eigen::Vector4d::Constant(scale), 0.0);
+    const PaddedPolygon unit_rows(square, Eigen::Vector4d::Constant(1.0), 0.0);
+    EXPECT_EQ(tiny_rows.vertices(), unit_rows.vertices());
+    EXPECT_EQ(proximity(point, Pose({2, 0.5, 0}, {1, 0, 0, 0}), tiny_rows, Pose()).phi, 1.0);
+  }
+}
+
 // A sliver far thinner than it is long, its rows at 0, 90, 180 and 270 degrees as cos and sin
 // give them (6e-17 off): x <= e, y <= e, -x <= e, -y <= 1 with e = 1e-300 down to 1e-20. The row
 // y <= e is dropped (it cuts 1e-284 of a polygon of size 1), leaving the rows x <= e and

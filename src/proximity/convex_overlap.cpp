@@ -38,6 +38,9 @@ bool parallel(const HalfPlane& a, const HalfPlane& b) {
   return std::abs(cross(a.normal, b.normal)) <= 1e-12;
 }
 
+// Both lists' half-planes and the box's 4, on the stack for two polygons of up to 32 vertices.
+constexpr Eigen::Index kInlinePlanes = 2 * kInlineHalfPlanes + 4;
+
 // Half-plane intersection by angle (the sort-and-sweep algorithm): half-planes sorted by the
 // angle of their normal are pushed on a deque; before each push, half-planes at either end whose
 // corner with their neighbour lies outside the new one are redundant and dropped. Four box
@@ -45,10 +48,11 @@ bool parallel(const HalfPlane& a, const HalfPlane& b) {
 // normals on the deque always turn by less than pi unless the region is empty: a turn of pi or
 // more (across the deque's ends too) reports it empty. Writes the region's vertices,
 // counterclockwise, and returns their number (0: empty).
-Eigen::Index intersect(SmallBuffer<HalfPlane, 72>& planes, SmallBuffer<Eigen::Vector2d, 72>& out) {
+Eigen::Index intersect(SmallBuffer<HalfPlane, kInlinePlanes>& planes,
+                       SmallBuffer<Eigen::Vector2d, kInlinePlanes>& out) {
   std::sort(planes.data(), planes.data() + planes.size(),
             [](const HalfPlane& a, const HalfPlane& b) { return angle_less(a.normal, b.normal); });
-  SmallBuffer<HalfPlane, 72> deque(planes.size());
+  SmallBuffer<HalfPlane, kInlinePlanes> deque(planes.size());
   Eigen::Index head = 0, tail = 0;  // the deque is deque[head, tail)
   for (Eigen::Index i = 0; i < planes.size(); ++i) {
     const HalfPlane& h = planes[i];
@@ -101,8 +105,8 @@ Eigen::Index intersect(SmallBuffer<HalfPlane, 72>& planes, SmallBuffer<Eigen::Ve
 // region whose width area / diameter is within 8 slack is a sliver along a touching edge (or a
 // point): its longest extent's middle is returned instead, since the centroid of a sliver depends
 // on the rounding that shaped it.
-Eigen::Vector2d region_centre(const SmallBuffer<Eigen::Vector2d, 72>& vertices, Eigen::Index count,
-                              double slack) {
+Eigen::Vector2d region_centre(const SmallBuffer<Eigen::Vector2d, kInlinePlanes>& vertices,
+                              Eigen::Index count, double slack) {
   const Eigen::Vector2d& origin = vertices[0];
   Eigen::Index farthest = 0;
   double area = 0.0;
@@ -134,7 +138,7 @@ Eigen::Vector2d region_centre(const SmallBuffer<Eigen::Vector2d, 72>& vertices, 
 bool overlap_centre(const HalfPlane* first, Eigen::Index first_count, double first_extent,
                     const HalfPlane* second, Eigen::Index second_count, double slack,
                     Eigen::Vector2d& centre) {
-  SmallBuffer<HalfPlane, 72> planes(first_count + second_count + 4);
+  SmallBuffer<HalfPlane, kInlinePlanes> planes(first_count + second_count + 4);
   Eigen::Index n = 0;
   for (Eigen::Index i = 0; i < first_count; ++i) {
     planes[n++] = {first[i].normal, first[i].offset + slack};
@@ -148,7 +152,7 @@ bool overlap_centre(const HalfPlane* first, Eigen::Index first_count, double fir
                                         Eigen::Vector2d(-1, 0), Eigen::Vector2d(0, -1)}) {
     planes[n++] = {normal, box};
   }
-  SmallBuffer<Eigen::Vector2d, 72> vertices(planes.size());
+  SmallBuffer<Eigen::Vector2d, kInlinePlanes> vertices(planes.size());
   const Eigen::Index count = intersect(planes, vertices);
   if (count == 0) return false;
   centre = region_centre(vertices, count, slack);

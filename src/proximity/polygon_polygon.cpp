@@ -42,7 +42,8 @@ Eigen::Index shadow_half_planes(const PolygonView& polygon, const Eigen::Matrix2
 // the other way), each polygon's spikes bevelled so that the slack does not stretch them.
 bool parallel_overlap(const PolygonView& a, const PolygonView& b, const PolygonPairFrame& frame,
                       double tolerance, Eigen::Vector2d& centre) {
-  SmallBuffer<HalfPlane> a_rows(a.size() + 3), b_rows(b.size() + 3);
+  // On the stack up to 32 vertices and their 3 bevels (kInlineHalfPlanes, convex_overlap.hpp).
+  SmallBuffer<HalfPlane, kInlineHalfPlanes> a_rows(a.size() + 3), b_rows(b.size() + 3);
   const Eigen::Index a_count =
       shadow_half_planes(a, Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero(), a_rows.data());
   const Eigen::Index b_count = shadow_half_planes(b, frame.b_in_a.topLeftCorner<2, 2>(),

@@ -39,6 +39,17 @@ EdgeBound edge_bound(const Segment& edge, double z_start, double z_end) {
           crosses ? 0.0 : std::min(std::abs(z_start), std::abs(z_end))};
 }
 
+// The bounds of B's edges (in A's frame; W: B's vertices there).
+template <class Polygon>
+SmallBuffer<EdgeBound> edge_bounds(const SmallBuffer<Segment>& edges,
+                                   const CarriedPolygon<Polygon>& W) {
+  SmallBuffer<EdgeBound> bounds(edges.size());
+  for (Eigen::Index j = 0; j < edges.size(); ++j) {
+    bounds[j] = edge_bound(edges[j], W.start(j).z(), W.end(j).z());
+  }
+  return bounds;
+}
+
 enum class Kind {
   kEdges,         // edge i of A at s, edge j of B at t (s, t = 1: the edges' end vertices)
   kBVertexOverA,  // vertex j of B over A's face
@@ -290,10 +301,7 @@ void visit_all_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
     for (Eigen::Index j = 0; j < kb; ++j) seed = std::min(seed, (vertex - W[j]).squaredNorm());
   }
   double reach = std::sqrt(seed) + band;
-  SmallBuffer<EdgeBound> b_bounds(kb);
-  for (Eigen::Index j = 0; j < kb; ++j) {
-    b_bounds[j] = edge_bound(b_edges[j], W.start(j).z(), W.end(j).z());
-  }
+  const SmallBuffer<EdgeBound> b_bounds = edge_bounds(b_edges, W);
   for (Eigen::Index i = 0; i < ka; ++i) {
     // A's edge with its heights over B's plane (X: A's vertices in B's frame).
     const EdgeBound a_bound = edge_bound(a_edges[i], X.start(i).z(), X.end(i).z());
@@ -422,12 +430,7 @@ std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
   // Whole polygons (PolygonView) always get every pair: the fast path sends only small ones here,
   // and the tests compare the windows with this full enumeration.
   if (std::is_same_v<Polygon, SubPolygon> && a.size() * kb > kSweepLimit) {
-    // The bounds that rule B's edges out of a sweep.
-    SmallBuffer<EdgeBound> b_bounds(kb);
-    for (Eigen::Index j = 0; j < kb; ++j) {
-      b_bounds[j] = edge_bound(b_edges[j], W.start(j).z(), W.end(j).z());
-    }
-    sweep_pairs(a, W, b_edges, b_bounds, tolerance, best);
+    sweep_pairs(a, W, b_edges, edge_bounds(b_edges, W), tolerance, best);
   } else {
     visit_all_pairs(a, W, X, b_edges, tolerance, std::max(tolerance, tie_tolerance), best);
   }
