@@ -61,10 +61,12 @@ Eigen::Vector4d UnitQuaternion::rotate_gradient(const Eigen::Vector3d& u,
 // Forming q' M q itself would overflow: |q| may reach ~1e100 and M ~1e200 in an accepted scene
 // (fuzz_proximity: a quaternion of norm 1e70 gave NaN); with n every product stays within M's
 // size, and only the final factor carries |q| (1 / |q|^2 within [2.5e-201, 1e80], as Pose keeps
-// |q| within [1e-40, 2e100]). Only the lower triangle is computed, then mirrored: exactly
-// symmetric.
-Eigen::Matrix4d UnitQuaternion::rotate_hessian(const Eigen::Vector3d& u,
-                                               const Eigen::Vector3d& w) const {
+// |q| within [1e-40, 2e100]). A caller's unit^2 goes into that factor too, as (unit / |q|)^2:
+// applied afterwards, a tiny product in a scaled frame (|q| = 1e100, u a length of 1e-15 in a scene
+// of 1e99, M ~ 1e-114) had gone through 2e-200 * M, subnormal, and come back with a few digits.
+// Only the lower triangle is computed, then mirrored: exactly symmetric.
+Eigen::Matrix4d UnitQuaternion::rotate_hessian(const Eigen::Vector3d& u, const Eigen::Vector3d& w,
+                                               double unit) const {
   const double u_dot_w = u.dot(w);
   const Eigen::Vector3d u_cross_w = u.cross(w);
   Eigen::Matrix4d M;
@@ -77,7 +79,8 @@ Eigen::Matrix4d UnitQuaternion::rotate_hessian(const Eigen::Vector3d& u,
   const Eigen::Vector4d M_unit = M * unit_;
   const double value = unit_.dot(M_unit);
   const Eigen::Vector4d g = 2.0 * (M_unit - value * unit_);
-  const double factor = 2.0 * inverse_norm_ * inverse_norm_;
+  const double unit_per_norm = unit * inverse_norm_;
+  const double factor = 2.0 * unit_per_norm * unit_per_norm;
   Eigen::Matrix4d hessian;
   for (int j = 0; j < 4; ++j) {
     for (int i = j; i < 4; ++i) {

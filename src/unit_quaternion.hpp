@@ -29,8 +29,11 @@ class UnitQuaternion {
   Eigen::Matrix<double, 3, 4> rotate_transpose_jacobian(const Eigen::Vector3d& v) const;
   // d/dq [ w . Q(q / |q|) u ]: w' rotate_jacobian(u), without forming the Jacobian.
   Eigen::Vector4d rotate_gradient(const Eigen::Vector3d& u, const Eigen::Vector3d& w) const;
-  // d^2/dq^2 [ w . Q(q / |q|) u ] (4x4, exactly symmetric).
-  Eigen::Matrix4d rotate_hessian(const Eigen::Vector3d& u, const Eigen::Vector3d& w) const;
+  // d^2/dq^2 [ w . Q(q / |q|) u ] (4x4, exactly symmetric), times unit^2: a caller working in a
+  // frame whose lengths are `unit` times smaller gets the Hessian in its callers' units with the
+  // factor folded in before the one power of 1 / |q|^2 (see the definition).
+  Eigen::Matrix4d rotate_hessian(const Eigen::Vector3d& u, const Eigen::Vector3d& w,
+                                 double unit = 1.0) const;
 
  private:
   // 2 G(qhat) / |q|, the map from d/dtheta to d/dq.

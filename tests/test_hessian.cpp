@@ -235,6 +235,34 @@ TEST(Hessian, FiniteAtExtremeQuaternionNormsAndDistances) {
             1e-12 * unit_block.norm());
 }
 
+// A tiny polygon beside a huge capsule, posed by |q| = 1 and by |q| = 1e100: the q block is the
+// unit one over 1e200 to its digits. The rotation's Hessian is ~2 |e| |u| / |q|^2 with u the
+// polygon's vertex; in the query's frame (lengths over ~1e99) u is ~1e-114, and the 1 / |q|^2
+// applied before the frame's units came back made a subnormal of it (a relative error of 1e-10 at
+// a side of 1e-15, everything lost at 1e-25).
+TEST(Hessian, RotationBlockOfAHugeQuaternionKeepsItsDigits) {
+  const double c = std::sqrt(0.5);
+  Eigen::MatrixX2d C(4, 2);
+  C << c, c, c, -c, -c, c, -c, -c;  // a square turned 45 degrees: one vertex on +x
+  for (const double side : {1e-15, 1e-25, 1e-40}) {
+    const PaddedPolygon a(C, Eigen::Vector4d::Constant(side), 0.0);
+    const Capsule b(1e99, 0.0);
+    const Pose pose_b(Eigen::Vector3d(1e98, 0, 5e98), Eigen::Vector4d(c, 0, 0, c));
+    const Pose unit(Eigen::Vector3d::Zero(), Eigen::Vector4d(1, 0, 0, 0));
+    const Pose huge(Eigen::Vector3d::Zero(), Eigen::Vector4d(1e100, 0, 0, 0));
+    const Matrix14 H1 = proximity_hessian(a, unit, b, pose_b).hessian;
+    const Matrix14 H2 = proximity_hessian(a, huge, b, pose_b).hessian;
+    const double largest = H1.block<4, 4>(3, 3).cwiseAbs().maxCoeff();
+    ASSERT_GT(largest, 0.0);
+    for (int i = 3; i < 7; ++i) {
+      for (int j = 3; j < 7; ++j) {
+        EXPECT_NEAR(H2(i, j), H1(i, j) * 1e-200, 1e-12 * largest * 1e-200)
+            << "side " << side << ", entry " << i << ", " << j;
+      }
+    }
+  }
+}
+
 // Two points whose gap is subnormal (fuzz_proximity: 5.2e-320): the normal's rate 1 / gap is
 // beyond the double range, so it is held fixed as at contact. Everything stays finite, and the
 // Hessian is then the fixed-normal one: zero in the positions (the distance is linear along the

@@ -45,8 +45,6 @@ void phi_hessian(double scale, const PosedCore& a, const ClosestFeature& side_a,
   const Eigen::Vector3d e = a.r + a.attitude.matrix() * side_a.body_point -
                             (b.r + b.attitude.matrix() * side_b.body_point);
   set_lower_gauss_newton(motion.turn, H);
-  H.block<4, 4>(kQ1, kQ1) += a.attitude.rotate_hessian(side_a.body_point, e);
-  H.block<4, 4>(kQ2, kQ2) -= b.attitude.rotate_hessian(side_b.body_point, e);
   switch (motion.free) {
     case 1:
       add_reduced_term<1>(motion, H);
@@ -72,6 +70,10 @@ void phi_hessian(double scale, const PosedCore& a, const ClosestFeature& side_a,
     const double column_factor = (j >= kQ1 && j < kR2) || j >= kQ2 ? scale : 1.0;
     for (int i = j; i < 14; ++i) H(j, i) = H(i, j) = H(i, j) * row_factors[i] * column_factor;
   }
+  // The rotations' own second derivatives, 2 d^2/dq^2 (e . Q(q) xi) per side, with the units
+  // folded in by rotate_hessian (times scale^2 before its 1 / |q|^2, which alone can underflow).
+  H.block<4, 4>(kQ1, kQ1) += 2.0 * a.attitude.rotate_hessian(side_a.body_point, e, scale);
+  H.block<4, 4>(kQ2, kQ2) -= 2.0 * b.attitude.rotate_hessian(side_b.body_point, e, scale);
 }
 
 }  // namespace diffpills::detail

@@ -22,7 +22,7 @@
 // Units: computed in the query's frame (pair_frame.hpp), then brought back by the scale s:
 // phi is s^2 times the frame's, positions are s times, quaternions unitless, so the r-r block is
 // unchanged, r-q entries are multiplied by s and q-q entries by s twice (one product each, as s^2
-// alone may underflow).
+// alone may underflow); the rotation Hessians get s^2 inside rotate_hessian, before its 1 / |q|^2.
 #pragma once
 
 #include <Eigen/Core>

@@ -25,7 +25,14 @@ Eigen::Vector3d lift(const Eigen::Vector2d& y) { return {y.x(), y.y(), 0.0}; }
 // What rules an edge pair out cheaply: two segments are at least |m1 - m2| - h1 - h2 apart (m the
 // midpoints, h the half-lengths), and an edge of one polygon that does not cross the other's plane
 // is at least its lower end's height above every point of the other (B's edges over A's plane, and
-// in visit_all_pairs A's over B's, each a whole row of pairs).
+// in visit_all_pairs A's over B's, each a whole row of pairs). The two combine: with A in z = 0,
+// the points' difference has a part along A's plane of at least |m1 - m2|_xy - h1 - h2 (projecting
+// onto the plane shortens the edges) and a part across it of at least B's edge's height, so
+//   distance^2 >= max(0, |m1 - m2|_xy - h1 - h2)^2 + height^2.
+// Facing, nearly parallel faces need this one: there every pair's height is about the best
+// distance, and the spheres' bound, which spends h1 + h2 of the margin in 3-D, let through every B
+// edge within ~sqrt(2 (h1 + h2) d) of an A edge along the plane (~360 of two 10^5-gons' edges per
+// A edge, 1 apart); this one only those within h1 + h2 + sqrt(2 d band).
 struct EdgeBound {
   Eigen::Vector3d middle;
   double half_length = 0.0;
@@ -247,10 +254,15 @@ void offer_edge_pair(const Segment& edge, const EdgeBound& a_bound, Eigen::Index
                      const Segment& other, const EdgeBound& b_bound, Eigen::Index j, double band,
                      double& reach, Best& best) {
   // |m_a - m_b| - h_a - h_b >= reach  <=>  |m_a - m_b|^2 >= (reach + h_a + h_b)^2.
-  const double far = reach + a_bound.half_length + b_bound.half_length;
-  if (b_bound.height >= reach || (a_bound.middle - b_bound.middle).squaredNorm() >= far * far) {
-    return;
-  }
+  const double half_lengths = a_bound.half_length + b_bound.half_length;
+  const double far = reach + half_lengths;
+  const Eigen::Vector3d apart = a_bound.middle - b_bound.middle;
+  if (b_bound.height >= reach || apart.squaredNorm() >= far * far) return;
+  // The bound along A's plane (EdgeBound): out when |m_a - m_b|_xy - h_a - h_b is at least
+  // sqrt(reach^2 - height^2), compared squared (both sides positive).
+  const double lateral =
+      half_lengths + std::sqrt((reach - b_bound.height) * (reach + b_bound.height));
+  if (apart.head<2>().squaredNorm() >= lateral * lateral) return;
   solve_edge_pair(edge, i, other, j, band, reach, best);
 }
 
@@ -317,8 +329,10 @@ void visit_all_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
 // keeps above or below A's plane, does not rule the rest out: a pair's points are at least
 // sqrt(dx^2 + gap^2) apart. Nearly parallel faces facing each other bring thousands of vertices
 // into both windows, and the double loop was quadratic (a hostile review: two 10^5-gons 1e-11
-// rad from parallel took 2.3 s); here each A feature meets the B features of a thin slab. The
-// pairs left out are those the double loop's bounds rule out too.
+// rad from parallel took 2.3 s); here each A feature meets the B features of a thin slab, about
+// h1 + h2 + sqrt(2 d band) wide for edges by the bound along the plane (EdgeBound; with the 3-D
+// spheres' bound alone, ~sqrt(2 (h1 + h2) d), and the sweep grew as k^1.3). The pairs left out are
+// those the double loop's bounds rule out too.
 template <class Polygon>
 void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
                  const SmallBuffer<Segment>& b_edges, const SmallBuffer<EdgeBound>& b_bounds,
@@ -379,11 +393,13 @@ void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
   };
   std::vector<Eigen::Index> long_edges;
   double middle_gap = std::numeric_limits<double>::infinity(), half_length = 0.0;
+  double height_gap = std::numeric_limits<double>::infinity();
   for (Eigen::Index j = 0; j < kb; ++j) {
     if (is_long(j)) {
       long_edges.push_back(j);
     } else {
       middle_gap = std::min(middle_gap, std::abs(b_bounds[j].middle.z()));
+      height_gap = std::min(height_gap, b_bounds[j].height);
       half_length = std::max(half_length, b_bounds[j].half_length);
     }
   }
@@ -402,8 +418,12 @@ void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
     visit(
         edges, middle_x, a_bound.middle.x(),
         [&](double dx) {
-          const double far = reach + a_bound.half_length + half_length;
-          return dx * dx + middle_gap * middle_gap < far * far;
+          // Both bounds of EdgeBound, with the least gap and the longest edge of the window.
+          const double half_lengths = a_bound.half_length + half_length;
+          const double far = reach + half_lengths;
+          const double lateral = std::max(0.0, std::abs(dx) - half_lengths);
+          return dx * dx + middle_gap * middle_gap < far * far &&
+                 lateral * lateral + height_gap * height_gap < reach * reach;
         },
         [&](Eigen::Index j) {
           offer_edge_pair(edge, a_bound, i, b_edges[j], b_bounds[j], j, tolerance, reach, best);
