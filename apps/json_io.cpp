@@ -1,5 +1,6 @@
 #include "json_io.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <set>
 #include <stdexcept>
@@ -275,15 +276,23 @@ Output to_json(const SignedDistanceJacobian& result) {
 
 Output matrix_rows(const Eigen::MatrixXd& matrix) { return rows(matrix); }
 
+// A polygon's d/dC and d/dd divide by the rows' lengths and are +-inf beyond the double range
+// (shape_gradient.hpp: rows of subnormal length). JSON has no infinity, and a null would hide the
+// sign and pass for an answer: the line is answered as an error naming the field instead.
 Output to_json(const std::array<ShapeGradient, 2>& shape_gradient) {
-  const auto one = [](const ShapeGradient& gradient) -> Output {
+  const auto one = [](const ShapeGradient& gradient, const char* shape) -> Output {
     if (const auto* capsule = std::get_if<CapsuleShapeGradient>(&gradient)) {
       return {{"length", capsule->length}, {"radius", capsule->radius}};
     }
     const auto& polygon = std::get<PolygonShapeGradient>(gradient);
+    if (!polygon.C.allFinite() || !polygon.d.allFinite() || !std::isfinite(polygon.radius)) {
+      throw std::invalid_argument(std::string("shape_gradient: ") + shape +
+                                  "'s gradient is beyond the double range (rows of C far "
+                                  "shorter than 1e-300?); ask without \"shape_gradient\"");
+    }
     return {{"C", rows(polygon.C)}, {"d", list(polygon.d)}, {"radius", polygon.radius}};
   };
-  return {{"a", one(shape_gradient[0])}, {"b", one(shape_gradient[1])}};
+  return {{"a", one(shape_gradient[0], "a")}, {"b", one(shape_gradient[1], "b")}};
 }
 
 }  // namespace diffpills::app

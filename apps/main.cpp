@@ -50,7 +50,9 @@ An answer:
    "shape_gradient": {"a": S, "b": S}}   (only if asked; of phi, and of the distance inside
                                            signed_distance: S = {"length", "radius"} for a
                                            capsule, {"C": m rows of 2, "d": [m], "radius"} for
-                                           a polygon, rows as given, redundant rows 0)
+                                           a polygon, rows as given, redundant rows 0; an
+                                           error if beyond the double range: rows of C
+                                           shorter than ~1e-300)
   The signed distance is the gap between the padded shapes, or minus their penetration depth.
   A line that is not a valid query is answered {"error": "<field>: <what is wrong>"}
   and the following lines are still answered.

@@ -57,6 +57,16 @@ status=$?
 [ "$status" -eq 1 ] || fail "10^6 keys: exit $status, expected 1 within 120 s"
 check_answers "$work/out" e
 
+# A shape gradient beyond the double range (rows of C of 1e-310: d phi/dC ~ 1/|C_i|) is an error
+# naming the field, not nulls in an answer (a hostile review: the sign was lost, exit status 0).
+# The same shape without "shape_gradient" is answered.
+tiny='{"type": "polygon", "C": [[1e-310,0],[0,1e-310],[-1e-310,0],[0,-1e-310]], "d": [1e-310,1e-310,1e-310,1e-310], "radius": 0, "r": [0,0,0], "q": [1,0,0,0]}'
+far='{"type": "capsule", "length": 1, "radius": 0.1, "r": [3,0.5,0.5], "q": [1,0.2,0.1,0]}'
+printf '{"a": %s, "b": %s, "shape_gradient": true}\n{"a": %s, "b": %s}\n' \
+  "$tiny" "$far" "$tiny" "$far" | "$bin" query > "$work/out"
+check_answers "$work/out" er
+grep -q '"error":"shape_gradient: a' "$work/out" || fail "an infinite shape gradient: no error"
+
 # Memory running out is an answer too, each such line followed by a valid query: a line of 4
 # million numbers under a 100 MB limit of address space (parsed, it needs ~2 GB), and a 60 MB line
 # under 50 MB (too long to keep). A hostile review: the parsed line's destructor allocated and

@@ -238,6 +238,49 @@ TEST(LargePolygons, TiesAndFacesMatchTheEnumeration) {
 
 // 10^5-gons: analytic answers. Two coplanar regular polygons side by side (apothem 1, centres
 // 2.5 apart: edge midpoints 0.5 apart), a sphere above the face and beside the rim.
+// Large windows of polygons within 1,000 intersection tolerances of their size ("specks", as two
+// polygons 1e12 times their size apart are): the sweep orders them by depth along the line between
+// them, or, close to each other, keeps its order with a band of 0, and solves only pairs that can
+// be closer than the best. Exercised where the brute force is exact: the windows are given a
+// tolerance of 1,000 for polygons of size ~1, at distances of 0.5 and 100 sizes beyond touching,
+// in both orders, with random poses. No bound may leave out a closer pair: the windows' distance is
+// the brute force's to rounding. (Their cost, k log k against ka kb before: BENCHMARKS.md.)
+TEST(LargePolygons, SpeckSweepLeavesNoCloserPairOut) {
+  Rng rng(41);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int trial = 0; trial < 40; ++trial) {
+    SCOPED_TRACE(::testing::Message() << "trial " << trial);
+    const TestShape a = many_sided(rng, 100 + 10 * trial, trial % 5 == 0);
+    const TestShape b = many_sided(rng, 150 + 7 * trial, trial % 7 == 0);
+    const double beyond = trial % 2 == 0 ? 0.5 : 100.0 * (a.size + b.size);
+    const Eigen::Vector3d direction =
+        Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng)).normalized();
+    const Pose pa = random_pose(rng, 1.0);
+    const Pose pb(pa.r() + (a.size + b.size + beyond) * direction, random_pose(rng, 1.0).q());
+    const long double reference =
+        brute_force_closest(to_world(a, pa), to_world(b, pb)).distance;
+    const auto& polygon_a = std::get<PaddedPolygon>(a.shape);
+    const auto& polygon_b = std::get<PaddedPolygon>(b.shape);
+    for (const bool swapped : {false, true}) {
+      const PaddedPolygon& first = swapped ? polygon_b : polygon_a;
+      const PaddedPolygon& second = swapped ? polygon_a : polygon_b;
+      const Pose& p1 = swapped ? pb : pa;
+      const Pose& p2 = swapped ? pa : pb;
+      const detail::PolygonView view_1(first, 1.0), view_2(second, 1.0);
+      const detail::PosedCore core_1{p1.r(), detail::UnitQuaternion(p1.q()), 0.0, first.extent()};
+      const detail::PosedCore core_2{p2.r(), detail::UnitQuaternion(p2.q()), 0.0, second.extent()};
+      const detail::PolygonPairFrame frame(core_1, core_2);
+      const detail::CarriedPolygon<detail::PolygonView> W(view_2, frame.b_in_a,
+                                                          frame.b_origin_in_a);
+      const Sides sides =
+          detail::closest_separated_by_windows(view_1, view_2, frame, W, 1e3, 1e-13);
+      const double distance = (world(core_1, sides[0]) - world(core_2, sides[1])).norm();
+      EXPECT_NEAR(distance, static_cast<double>(reference), 1e-12 * (1.0 + distance))
+          << (swapped ? "b, a" : "a, b");
+    }
+  }
+}
+
 TEST(LargePolygons, HundredThousandGons) {
   const int count = 100000;
   Eigen::MatrixX2d C(count, 2);
