@@ -17,6 +17,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -301,6 +302,30 @@ void PolygonPolygon_NearlyParallel(benchmark::State& state) {
   state.SetComplexityN(count);
 }
 BENCHMARK(PolygonPolygon_NearlyParallel)
+    ->RangeMultiplier(4)
+    ->Range(1024, 65536)
+    ->Arg(100000)
+    ->Complexity()
+    ->Unit(benchmark::kMillisecond);
+
+// Two unit-circumradius k-gons 1e13 and 1e30 times their size apart (in the plane, along a
+// diagonal), alternately: far beyond the point where the intersection tolerance (1e-12 of the
+// scene) exceeds their size and every feature pair ties, and where rounding makes every depth along
+// the line between them the same number (separated_polygons.cpp, sweep_specks).
+void PolygonPolygon_FarApart(benchmark::State& state) {
+  const auto count = static_cast<int>(state.range(0));
+  const PaddedPolygon polygon = regular_polygon(count, 1.0, 0.0);
+  const Pose origin;
+  const std::array<Pose, 2> far = {Pose({1e13, 0, 0}, {1, 0, 0, 0}),
+                                   Pose({7.0710678e29, 7.0710678e29, 0}, {1, 0, 0, 0})};
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(proximity(polygon, origin, polygon, far[i]));
+    i ^= 1;
+  }
+  state.SetComplexityN(count);
+}
+BENCHMARK(PolygonPolygon_FarApart)
     ->RangeMultiplier(4)
     ->Range(1024, 65536)
     ->Arg(100000)
