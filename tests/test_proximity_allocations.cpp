@@ -1,55 +1,16 @@
 // proximity(), proximity_jacobian() and signed_distance() of shapes with up to 32 vertices
-// allocate nothing (proximity.hpp, batch.hpp): this binary counts every heap allocation (it
-// defines malloc and its relatives over glibc's own, which Eigen's matrices and operator new both
-// reach) around calls in the configurations whose code paths keep buffers: stacked and coplanar
-// parallel polygons (the common region of two polygons), penetrating ones (the deepest facet),
-// capsules crossing a polygon and lying in its plane, at sizes on both sides of every buffer's
-// bound. Its own binary, since the definitions apply to everything linked in; not under
-// AddressSanitizer, which defines malloc itself (the test is skipped there, and labelled
-// no_sanitize).
+// allocate nothing (proximity.hpp, batch.hpp): this binary counts every heap allocation
+// (support/allocation_counter.hpp) around calls in the configurations whose code paths keep
+// buffers: stacked and coplanar parallel polygons (the common region of two polygons), penetrating
+// ones (the deepest facet), capsules crossing a polygon and lying in its plane, at sizes on both
+// sides of every buffer's bound. Skipped under AddressSanitizer (labelled no_sanitize).
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
-#include <cstddef>
 #include <string>
 
 #include "diffpills/diffpills.hpp"
-
-namespace {
-std::atomic<long> allocations{0};
-}  // namespace
-
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kCounting = false;
-#else
-constexpr bool kCounting = true;
-extern "C" {
-void* __libc_malloc(std::size_t size);
-void* __libc_calloc(std::size_t count, std::size_t size);
-void* __libc_realloc(void* p, std::size_t size);
-void* __libc_memalign(std::size_t alignment, std::size_t size);
-void __libc_free(void* p);
-
-void* malloc(std::size_t size) noexcept {
-  ++allocations;
-  return __libc_malloc(size);
-}
-void* calloc(std::size_t count, std::size_t size) noexcept {
-  ++allocations;
-  return __libc_calloc(count, size);
-}
-void* realloc(void* p, std::size_t size) noexcept {
-  ++allocations;
-  return __libc_realloc(p, size);
-}
-void* aligned_alloc(std::size_t alignment, std::size_t size) noexcept {
-  ++allocations;
-  return __libc_memalign(alignment, size);
-}
-void free(void* p) noexcept { __libc_free(p); }
-}
-#endif
+#include "support/allocation_counter.hpp"
 
 namespace diffpills {
 namespace {
@@ -73,13 +34,13 @@ long allocations_of(const A& a, const Pose& pose_a, const B& b, const Pose& pose
     signed_distance(a, pose_a, b, pose_b);
   };
   all();
-  const long before = allocations.load();
+  const long before = testing::heap_allocations();
   all();
-  return allocations.load() - before;
+  return testing::heap_allocations() - before;
 }
 
 TEST(ProximityAllocations, NoneUpToThirtyTwoVertices) {
-  if (!kCounting) GTEST_SKIP() << "AddressSanitizer defines malloc";
+  if (!testing::kCountingAllocations) GTEST_SKIP() << "AddressSanitizer defines malloc";
   const Capsule capsule(1.0, 0.1);
   const Eigen::Vector4d level(1, 0, 0, 0), tilted(1, 0, 1, 0);
   for (const int k : {3, 8, 16, 17, 31, 32}) {

@@ -1,13 +1,8 @@
 // The fixed-size solver's inner loops allocate nothing (issue 13): this binary counts every heap
-// allocation (it defines malloc and its relatives over glibc's own, which Eigen's matrices and
-// operator new both reach) and compares whole solves that differ only in how many iLQR iterations
-// they run. Its own binary, since the definitions apply to everything linked in; not under
-// AddressSanitizer, which defines malloc itself (the test is skipped there, and labelled
-// no_sanitize).
+// allocation (support/allocation_counter.hpp) and compares whole solves that differ only in how
+// many iLQR iterations they run. Skipped under AddressSanitizer (labelled no_sanitize).
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <vector>
@@ -15,41 +10,7 @@
 #include "diffpills/trajopt/altro.hpp"
 #include "diffpills/trajopt/car.hpp"
 #include "diffpills/trajopt/dynamic_problem.hpp"
-
-namespace {
-std::atomic<long> allocations{0};
-}  // namespace
-
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kCounting = false;
-#else
-constexpr bool kCounting = true;
-extern "C" {
-void* __libc_malloc(std::size_t size);
-void* __libc_calloc(std::size_t count, std::size_t size);
-void* __libc_realloc(void* p, std::size_t size);
-void* __libc_memalign(std::size_t alignment, std::size_t size);
-void __libc_free(void* p);
-
-void* malloc(std::size_t size) noexcept {
-  ++allocations;
-  return __libc_malloc(size);
-}
-void* calloc(std::size_t count, std::size_t size) noexcept {
-  ++allocations;
-  return __libc_calloc(count, size);
-}
-void* realloc(void* p, std::size_t size) noexcept {
-  ++allocations;
-  return __libc_realloc(p, size);
-}
-void* aligned_alloc(std::size_t alignment, std::size_t size) noexcept {
-  ++allocations;
-  return __libc_memalign(alignment, size);
-}
-void free(void* p) noexcept { __libc_free(p); }
-}
-#endif
+#include "support/allocation_counter.hpp"
 
 namespace diffpills::trajopt {
 namespace {
@@ -96,15 +57,15 @@ long allocations_of_solve(const Problem& problem, int iterations, int* ran) {
   settings.polish = false;
   const Eigen::VectorXd x0 = Eigen::VectorXd::Zero(5);
   const std::vector<Eigen::VectorXd> guess(40, Eigen::VectorXd::Zero(2));
-  const long before = allocations.load();
+  const long before = testing::heap_allocations();
   const AltroResult result = solve(problem, x0, guess, settings);
-  const long used = allocations.load() - before;
+  const long used = testing::heap_allocations() - before;
   *ran = result.iterations;
   return used;
 }
 
 TEST(TrajoptAllocations, FixedSizeIterationsAllocateNothing) {
-  if (!kCounting) GTEST_SKIP() << "AddressSanitizer owns malloc";
+  if (!testing::kCountingAllocations) GTEST_SKIP() << "AddressSanitizer owns malloc";
   const CarToAPoint problem;
   int short_run = 0, long_run = 0;
   // A warm-up solve first, so that one-time allocations (the C++ runtime's, a lazily built
