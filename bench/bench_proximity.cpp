@@ -332,6 +332,57 @@ BENCHMARK(PolygonPolygon_FarApart)
     ->Complexity()
     ->Unit(benchmark::kMillisecond);
 
+// Needles thinner than the tolerance their radii set: two 1000:1 ellipses of k vertices, 4e-11
+// long and 4e-14 wide, radius 1, the second turned a quarter about y and 3e-11 beside the first, so
+// each crosses the other's plane. The windows judge their ties by the cores' own size
+// (polygon_windows.cpp, window_tie_tolerance); by the scene's, both were taken whole and swept
+// (0.35 s at 8,000 vertices, 1.6-1.9 s at 40,000).
+PaddedPolygon needle(int count, double phase) {
+  const double length = 2e-11;
+  Eigen::MatrixX2d C(count, 2);
+  Eigen::VectorXd d(count);
+  const auto at = [&](int k) {
+    const double angle = phase + 2 * M_PI * k / count;
+    return Eigen::Vector2d(1e-3 * length * std::cos(angle), length * std::sin(angle));
+  };
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector2d p = at(i), q = at(i + 1);
+    const Eigen::Vector2d normal = Eigen::Vector2d(q.y() - p.y(), p.x() - q.x()).normalized();
+    C.row(i) = normal.transpose();
+    d(i) = normal.dot(p);
+  }
+  return PaddedPolygon(C, d, 1.0);
+}
+
+void PolygonPolygon_Needles(benchmark::State& state) {
+  const auto count = static_cast<int>(state.range(0));
+  const PaddedPolygon a = needle(count, 0.0), b = needle(count, 0.3);
+  const Pose origin, beside({3e-11, 0, 0}, {std::sqrt(0.5), 0, std::sqrt(0.5), 0});
+  for (auto _ : state) benchmark::DoNotOptimize(proximity(a, origin, b, beside));
+  state.SetComplexityN(count);
+}
+BENCHMARK(PolygonPolygon_Needles)
+    ->RangeMultiplier(4)
+    ->Range(1024, 65536)
+    ->Arg(100000)
+    ->Complexity()
+    ->Unit(benchmark::kMillisecond);
+// The same needles crossing (the second 1e-14 beside the first's middle, through its plane): the
+// signed distance's penetration search, at the needles' own scale (signed_distance.cpp).
+void PolygonPolygon_SignedDistanceNeedles(benchmark::State& state) {
+  const auto count = static_cast<int>(state.range(0));
+  const PaddedPolygon a = needle(count, 0.0), b = needle(count, 0.3);
+  const Pose origin, crossing({1e-14, 0, 0}, {std::sqrt(0.5), 0, std::sqrt(0.5), 0});
+  for (auto _ : state) benchmark::DoNotOptimize(signed_distance(a, origin, b, crossing));
+  state.SetComplexityN(count);
+}
+BENCHMARK(PolygonPolygon_SignedDistanceNeedles)
+    ->RangeMultiplier(4)
+    ->Range(1024, 65536)
+    ->Arg(100000)
+    ->Complexity()
+    ->Unit(benchmark::kMillisecond);
+
 // Two k-gons crossing (the signed distance in penetration): the unit-circumradius k-gon at the
 // origin, the 0.7 one turned off its plane by 30 to 90 degrees about a random in-plane axis, its
 // centre within 0.3 of the first's: 64 such poses, cycled. D has ~k^2 / 2 edge-pair facets; above

@@ -35,4 +35,9 @@ PairFrame make_pair_frame(double size_a, double radius_a, double size_b, double 
   return frame;
 }
 
+double speck_scene(double size_a, double size_b, double distance, double tolerance) {
+  if (size_a + size_b > 1e3 * tolerance || std::min(size_a, size_b) < 1e-100) return 0.0;
+  return std::max({size_a, size_b, distance});
+}
+
 }  // namespace diffpills::detail

@@ -37,6 +37,17 @@ struct PairFrame {
   double tie_tolerance = 0.0;
 };
 
+// Specks: two cores whose sizes add up to at most 1,000 intersection tolerances (1e-9 of the
+// scene), so that their radii, or the distance between them, make the scene. Returns the bare
+// cores' own scene in the frame's units, the largest of their sizes and the distance between their
+// body origins, for the searches whose allowances must then be relative to the cores rather than
+// to the scene (polygon_windows.cpp, penetration.hpp): a needle 4e-11 long and 4e-14 wide beside
+// radii of 1 lies wholly within 1e-12 of the scene of any plane along it, and an allowance of
+// that size rules none of its features out. Returns 0 for cores that are not specks, and for
+// cores below 1e-100 of the frame's units (products of their coordinates lose digits to
+// underflow): those keep the scene's allowances. `tolerance`: the frame's intersection tolerance.
+double speck_scene(double size_a, double size_b, double distance, double tolerance);
+
 // size_* is a core's length scale (a capsule's length, a polygon's extent), radius_* its padding.
 PairFrame make_pair_frame(double size_a, double radius_a, double size_b, double radius_b,
                           const Eigen::Vector3d& r_a, const Eigen::Vector3d& r_b);

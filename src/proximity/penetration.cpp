@@ -193,6 +193,8 @@ class FacetSearch final : public NearNormalEdgePairs {
       : a_(a),
         b_(b),
         tolerance_(tolerance),
+        value_rounding_(1e-3 * tolerance),
+        bound_slack_(tolerance),
         offset_(b.posed().r - a.posed().r),
         z1_(a.face_normal()) {}
 
@@ -207,7 +209,7 @@ class FacetSearch final : public NearNormalEdgePairs {
         candidate.depth = a_.support(n) + b_.support(-n);
         candidate.normal = n;
         candidate.face_core = core;
-        offer(candidate, kValueRounding);
+        offer(candidate, value_rounding_);
       }
     }
   }
@@ -221,7 +223,7 @@ class FacetSearch final : public NearNormalEdgePairs {
     const Eigen::Vector3d n = c / sine;
     const Eigen::Vector3d between = e.start - f.start;
     const double gap = n.dot(between);
-    const double rounding = kValueRounding * (1.0 + between.norm() / sine);
+    const double rounding = value_rounding_ + kDirectionRounding * between.norm() / sine;
     for (const double sign : {1.0, -1.0}) {
       // How far n leans out of each edge's normal cone (zero for a segment, whose cone is every
       // normal), at most the allowance.
@@ -252,11 +254,11 @@ class FacetSearch final : public NearNormalEdgePairs {
   // sqrt(|x1 - x2|^2 - value^2) <= sqrt(limit^2 - (limit - 2 tolerance)^2), and is kept too
   // (unless its value is uncertain, nearly parallel edges: ties may then be broken otherwise
   // than by visiting every pair).
-  double distance_bound() const override { return limit() + kRounding; }
+  double distance_bound() const override { return limit() + bound_slack_; }
   double normal_slack() const override {
     const double bound = std::max(limit(), 0.0);
     const double low = std::max(bound - 2.0 * tolerance_, 0.0);
-    return std::sqrt(bound * bound - low * low) + kRounding;
+    return std::sqrt(bound * bound - low * low) + bound_slack_;
   }
   void visit(Eigen::Index edge_a, Eigen::Index edge_b) override { consider_edges(edge_a, edge_b); }
 
@@ -293,15 +295,19 @@ class FacetSearch final : public NearNormalEdgePairs {
     return candidate.witnesses.has_value();
   }
 
-  // In the frame's units (the scene's size in [1, 2)): a value's rounding, a few ulps of the
-  // scene; and how far the edge-pair search's bounds are kept above what they bound, far above
-  // the rounding of the sums that form them.
-  static constexpr double kValueRounding = 1e-15;
-  static constexpr double kRounding = 1e-12;
+  // An edge pair's normal e x f / |e x f| is off by ~2 ulps of the directions over the sine.
+  static constexpr double kDirectionRounding = 1e-15;
 
   const CoreOutline& a_;
   const CoreOutline& b_;
   double tolerance_;
+  // Relative to the tolerance, 1e-12 of the length the search works at (the frame's scene, or a
+  // speck pair's own: pair_frame.hpp, speck_scene): a value's rounding, a few ulps of it; and how
+  // far the edge-pair search's bounds are kept above what they bound, far above the rounding of
+  // the sums that form them. Relative to the scene where the radii make it, both exceeded a
+  // needle's width (4e-14 beside radii of 1), the hierarchies ruled no pair out, and two crossing
+  // needles of 64,000 vertices took 11 s.
+  double value_rounding_, bound_slack_;
   Eigen::Vector3d offset_, z1_;
   DeepestFacet lowest_, best_;
   double depth_bound_ = std::numeric_limits<double>::infinity();

@@ -88,6 +88,8 @@ struct DeepestFacet {
 // pair up to 32 x 32), or every pair (for tests of the hierarchies).
 enum class EdgePairVisits { kPruned, kEvery };
 
+// `tolerance`: ties and touching, in the frame's units; the search's rounding allowances are
+// relative to it (the frame's, or a speck pair's own: pair_frame.hpp, speck_scene).
 DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double tolerance,
                            EdgePairVisits visits = EdgePairVisits::kPruned);
 

@@ -7,6 +7,7 @@
 #include "diffpills/signed_distance.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <optional>
 #include <type_traits>
 #include <variant>
@@ -103,7 +104,12 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   const std::optional<PolygonView> view_b = polygon_view(b, frame);
   const CoreOutline outline_a = outline(a, pa, view_a ? &*view_a : nullptr);
   const CoreOutline outline_b = outline(b, pb, view_b ? &*view_b : nullptr);
-  const DeepestFacet facet = detail::deepest_facet(outline_a, outline_b, frame.tolerance);
+  // Specks (pair_frame.hpp) are searched at their own scale: at the scene's, the search's
+  // allowances exceed their width and its hierarchies rule no edge pair out.
+  const double speck = detail::speck_scene(pa.size, pb.size, (pb.r - pa.r).norm(), frame.tolerance);
+  const double search_tolerance =
+      speck > 0.0 ? std::min(frame.tolerance, 1e-12 * speck) : frame.tolerance;
+  const DeepestFacet facet = detail::deepest_facet(outline_a, outline_b, search_tolerance);
   solution.penetrating = true;
   solution.source = facet_source(facet, outline_a, outline_b);
   if (facet.kind == DeepestFacet::Kind::kNone) {
