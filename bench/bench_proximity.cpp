@@ -334,8 +334,8 @@ BENCHMARK(PolygonPolygon_FarApart)
 
 // Needles thinner than the tolerance their radii set: two 1000:1 ellipses of k vertices, 4e-11
 // long and 4e-14 wide, radius 1, the second turned a quarter about y and 3e-11 beside the first, so
-// each crosses the other's plane. The windows judge their ties by the cores' own size
-// (polygon_windows.cpp, window_tie_tolerance); by the scene's, both were taken whole and swept
+// each crosses the other's plane. Two polygons are solved at their cores' own tolerances
+// (pair_setup.hpp, search_tolerances); at the scene's, both were taken whole and swept
 // (0.35 s at 8,000 vertices, 1.6-1.9 s at 40,000).
 PaddedPolygon needle(int count, double phase) {
   const double length = 2e-11;
@@ -368,7 +368,7 @@ BENCHMARK(PolygonPolygon_Needles)
     ->Complexity()
     ->Unit(benchmark::kMillisecond);
 // The same needles crossing (the second 1e-14 beside the first's middle, through its plane): the
-// signed distance's penetration search, at the needles' own scale (signed_distance.cpp).
+// signed distance's penetration search, at the needles' own tolerance (penetration.hpp).
 void PolygonPolygon_SignedDistanceNeedles(benchmark::State& state) {
   const auto count = static_cast<int>(state.range(0));
   const PaddedPolygon a = needle(count, 0.0), b = needle(count, 0.3);

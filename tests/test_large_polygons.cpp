@@ -243,11 +243,12 @@ TEST(LargePolygons, TiesAndFacesMatchTheEnumeration) {
 // them, or, close to each other, keeps its order with a band of 0, and solves only pairs that can
 // be closer than the best. Exercised where the brute force is exact: polygons of size ~1 given a
 // tolerance of 1,000, at distances of 0.5 and 100 sizes beyond touching, in both orders, with
-// random poses. The sweep is called on windows holding every vertex (the public path's windows
-// for specks judge ties by the cores' own size, window_tie_tolerance, and stay small; a far speck
-// pair with tolerance 1e-12 of the distance does reach it whole, PolygonPolygon_FarApart), and the
-// windows on the same pairs. No bound may leave out a closer pair: both distances are the brute
-// force's to rounding. (Their cost, k log k against ka kb before: BENCHMARKS.md.)
+// random poses: the sweep called on windows holding every vertex, and the windows (which take
+// both polygons whole at that tolerance) on the same pairs. In the public queries polygons reach
+// the sweep's speck regimes where the distance makes the scene (PolygonPolygon_FarApart); where
+// radii make it, two polygons are solved at their cores' own tolerances (pair_setup.hpp) and are
+// specks only as the bare cores would be. No bound may leave out a closer pair: both distances are
+// the brute force's to rounding. (Their cost, k log k against ka kb before: BENCHMARKS.md.)
 TEST(LargePolygons, SpeckSweepLeavesNoCloserPairOut) {
   Rng rng(41);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
@@ -319,11 +320,12 @@ TestShape needle(int count, double phase, double radius) {
 }
 
 // Needles far thinner than the tolerance their radii set (the radii make the scene): 1000:1
-// ellipses 4e-11 long, radius 1 or 0, at random poses within a few needle lengths. Before the
-// windows judged such cores' ties by their own size (window_tie_tolerance), every vertex of each
-// tied with its support, and a pair crossing each other's planes swept nearly all edge pairs
-// (4x10^4 vertices: 1.6-1.9 s, PolygonPolygon_Needles); the answer must be unchanged: the cores'
-// distance the brute force's to rounding, with radius 1 as with radius 0, in both orders.
+// ellipses 4e-11 long, radius 1 or 0, at random poses within a few needle lengths. Before two
+// polygons were solved at their cores' own tolerances (pair_setup.hpp, search_tolerances), every
+// vertex of each tied with its support at the scene's, and a pair crossing each other's planes
+// swept nearly all edge pairs (4x10^4 vertices: 1.6-1.9 s, PolygonPolygon_Needles); the answer
+// must be unchanged: the cores' distance the brute force's to rounding, with radius 1 as with
+// radius 0, in both orders.
 TEST(LargePolygons, NeedlesThinnerThanTheTolerance) {
   Rng rng(59);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -392,6 +394,82 @@ TEST(LargePolygons, NeedleSignedDistancesThinnerThanTheTolerance) {
     EXPECT_LE((ab.normal + ba.normal).norm(), 1e-12);
   }
   EXPECT_GE(penetrating, 12);
+}
+
+// Cores from 5e-10 to 1e-6 of the radii that make the scene (a hostile review: discs just above
+// the 1e-9 below which a pair counted as specks took 0.8-1.3 s at 10^5 vertices, 1,000x the same
+// cores with radius 0, with ~1,400 vertices of each within the scene's tolerance of a support), and
+// needles apart by about that tolerance, whose signed distance came out -7e-14 and penetrating for
+// a gap of 1.04e-12: two polygons are solved at their cores' own tolerances. The cores' distance
+// and signed gap must be the brute force's, with radius 1 as with radius 0 and in both orders.
+TEST(LargePolygons, CoresFarSmallerThanTheirRadii) {
+  Rng rng(67);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int trial = 0; trial < 24; ++trial) {
+    SCOPED_TRACE(::testing::Message() << "trial " << trial);
+    const double size = std::pow(10.0, -9.3 + 0.15 * trial);
+    TestShape a = many_sided(rng, 40 + trial, trial % 4 == 0);
+    TestShape b = many_sided(rng, 45 + trial, trial % 5 == 0);
+    // Shrunk to `size` (the rows keep their normals, the offsets scale), padded by 1.
+    for (TestShape* shape : {&a, &b}) {
+      const auto& polygon = std::get<PaddedPolygon>(shape->shape);
+      shape->shape =
+          PaddedPolygon(polygon.constraint_matrix(), size * polygon.constraint_offsets(), 1.0);
+      for (Eigen::Vector3d& vertex : shape->body_vertices) vertex *= size;
+      shape->size *= size;
+    }
+    const Pose pa(size * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)),
+                  Eigen::Vector4d(normal(rng), normal(rng), normal(rng), normal(rng)));
+    const Pose pb(pa.r() + 2.5 * size * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)),
+                  Eigen::Vector4d(normal(rng), normal(rng), normal(rng), normal(rng)));
+    const WorldCore wa = to_world(a, pa), wb = to_world(b, pb);
+    const long double apart = brute_force_closest(wa, wb).distance;
+    const double gap =
+        static_cast<double>(apart > 0 ? apart : -brute_force_penetration_depth(wa, wb));
+    const auto& padded_a = std::get<PaddedPolygon>(a.shape);
+    const auto& padded_b = std::get<PaddedPolygon>(b.shape);
+    const PaddedPolygon bare_a(padded_a.constraint_matrix(), padded_a.constraint_offsets(), 0.0);
+    const PaddedPolygon bare_b(padded_b.constraint_matrix(), padded_b.constraint_offsets(), 0.0);
+    const Proximity ab = proximity(padded_a, pa, padded_b, pb);
+    const Proximity ba = proximity(padded_b, pb, padded_a, pa);
+    const Proximity bare = proximity(bare_a, pa, bare_b, pb);
+    const SignedDistance sd_ab = signed_distance(padded_a, pa, padded_b, pb);
+    const SignedDistance sd_ba = signed_distance(padded_b, pb, padded_a, pa);
+    // Rounding: the cores' coordinates reach ~10 sizes; the signed distance adds the radii, 2.
+    const double within = 1e-12 * size;
+    if (apart > 0) {
+      const auto core_distance = [](const Proximity& p) {
+        return (p.core_points[0] - p.core_points[1]).norm();
+      };
+      EXPECT_NEAR(core_distance(ab), static_cast<double>(apart), within);
+      EXPECT_NEAR(core_distance(ba), static_cast<double>(apart), within);
+      EXPECT_LE((ab.core_points[0] - bare.core_points[0]).norm(), 1e-9 * size);
+      EXPECT_LE((ab.core_points[0] - ba.core_points[1]).norm(), 1e-9 * size);
+    }
+    EXPECT_NEAR(sd_ab.distance + 2.0, gap, 4e-16 + within);
+    EXPECT_EQ(sd_ab.distance, sd_ba.distance);
+    EXPECT_EQ(sd_ab.penetrating, apart == 0);  // the cores' penetration, not the padded shapes'
+  }
+  // The review's needles, 1.04e-12 apart: a gap, found as for radius 0.
+  const Eigen::Vector4d q(0.4560115303701098, -0.5485457321125106, 0.5936640938504344,
+                          0.3724432945072346);
+  const Pose pb(
+      Eigen::Vector3d(5.88264993311052e-13, 5.684448263159357e-14, 1.0934259732248938e-12), q);
+  for (const int count : {200, 1200}) {
+    const TestShape a = needle(count, 0.0, 1.0), b = needle(count + 13, 0.3, 1.0);
+    const long double apart = brute_force_closest(to_world(a, Pose()), to_world(b, pb)).distance;
+    ASSERT_GT(apart, 1e-12);
+    for (const bool swapped : {false, true}) {
+      const SignedDistance sd = swapped ? signed_distance(std::get<PaddedPolygon>(b.shape), pb,
+                                                          std::get<PaddedPolygon>(a.shape), Pose())
+                                        : signed_distance(std::get<PaddedPolygon>(a.shape), Pose(),
+                                                          std::get<PaddedPolygon>(b.shape), pb);
+      EXPECT_NEAR(sd.distance + 2.0, static_cast<double>(apart), 4e-16) << count << swapped;
+      EXPECT_NEAR((sd.core_points[1] - sd.core_points[0]).norm(), static_cast<double>(apart),
+                  1e-12 * kNeedleLength)
+          << count << swapped;
+    }
+  }
 }
 
 // 10^5-gons: analytic answers. Two coplanar regular polygons side by side (apothem 1, centres

@@ -35,9 +35,13 @@ PairFrame make_pair_frame(double size_a, double radius_a, double size_b, double 
   return frame;
 }
 
-double speck_scene(double size_a, double size_b, double distance, double tolerance) {
-  if (size_a + size_b > 1e3 * tolerance || std::min(size_a, size_b) < 1e-100) return 0.0;
-  return std::max({size_a, size_b, distance});
+CoreTolerances core_tolerances(const PairFrame& frame, double size_a, double size_b,
+                               double distance) {
+  const double cores = std::max({size_a, size_b, distance});
+  if (cores < 1e-100) return {frame.tolerance, frame.tie_tolerance};
+  return {std::min(frame.tolerance, 1e-12 * cores),
+          std::min(frame.tie_tolerance, 2e-12 * std::max(size_a, size_b) +
+                                            64 * std::numeric_limits<double>::epsilon() * cores)};
 }
 
 }  // namespace diffpills::detail

@@ -37,16 +37,23 @@ struct PairFrame {
   double tie_tolerance = 0.0;
 };
 
-// Specks: two cores whose sizes add up to at most 1,000 intersection tolerances (1e-9 of the
-// scene), so that their radii, or the distance between them, make the scene. Returns the bare
-// cores' own scene in the frame's units, the largest of their sizes and the distance between their
-// body origins, for the searches whose allowances must then be relative to the cores rather than
-// to the scene (polygon_windows.cpp, penetration.hpp): a needle 4e-11 long and 4e-14 wide beside
-// radii of 1 lies wholly within 1e-12 of the scene of any plane along it, and an allowance of
-// that size rules none of its features out. Returns 0 for cores that are not specks, and for
-// cores below 1e-100 of the frame's units (products of their coordinates lose digits to
-// underflow): those keep the scene's allowances. `tolerance`: the frame's intersection tolerance.
-double speck_scene(double size_a, double size_b, double distance, double tolerance);
+// The tolerances the bare cores would be solved with, in this frame's units: those of
+// make_pair_frame without the radii, 1e-12 of the cores' own scene (the larger core size and
+// the distance between the body origins) and 2e-12 of the larger core plus 64 ulps of that scene,
+// where they are finer than the frame's. They are where the radii make the scene: the coordinates
+// of a pair's cores, taken from shape a's body origin, reach only the cores' scene, and their
+// rounding with it; the radii play no part in which core points are closest. Searches whose pruning
+// is only as fine as the tolerance need them there: a needle 4e-11 long and 4e-14 wide beside radii
+// of 1 lies wholly within 1e-12 of the scene of any plane along it, and discs 5e-10 across beside
+// radii of 1 have ~1,400 of 10^5 vertices within it of a support line (polygon_windows.cpp,
+// penetration.hpp). Cores below 1e-100 of the frame's units keep the frame's: products of their
+// coordinates lose digits to underflow.
+struct CoreTolerances {
+  double intersection = 0.0;
+  double tie = 0.0;
+};
+CoreTolerances core_tolerances(const PairFrame& frame, double size_a, double size_b,
+                               double distance);
 
 // size_* is a core's length scale (a capsule's length, a polygon's extent), radius_* its padding.
 PairFrame make_pair_frame(double size_a, double radius_a, double size_b, double radius_b,

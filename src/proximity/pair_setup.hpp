@@ -43,11 +43,28 @@ inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Capsu
                                                       frame.tolerance, frame.tie_tolerance);
   return {swapped[1], swapped[0]};
 }
+
+// The tolerances a pair's cores are searched with: the frame's, except for two polygons, which
+// are searched at the bare cores' own (core_tolerances, pair_frame.hpp). Capsule pairs are solved
+// in closed form and a capsule against a k-gon in O(k) whatever the tolerance; two polygons are
+// searched in windows and hierarchies whose pruning is only as fine as it.
+template <class ShapeA, class ShapeB>
+CoreTolerances search_tolerances(const ShapeA&, const PosedCore&, const ShapeB&, const PosedCore&,
+                                 const PairFrame& frame) {
+  return {frame.tolerance, frame.tie_tolerance};
+}
+inline CoreTolerances search_tolerances(const PaddedPolygon&, const PosedCore& pa,
+                                        const PaddedPolygon&, const PosedCore& pb,
+                                        const PairFrame& frame) {
+  return core_tolerances(frame, pa.size, pb.size, (pb.r - pa.r).norm());
+}
+
 inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const PaddedPolygon& b,
                         const PosedCore& pb, const PairFrame& frame) {
+  const CoreTolerances tolerances = search_tolerances(a, pa, b, pb, frame);
   return detail::solve_polygon_polygon(PolygonView(a, frame.inverse_scale), pa,
-                                       PolygonView(b, frame.inverse_scale), pb, frame.tolerance,
-                                       frame.tie_tolerance);
+                                       PolygonView(b, frame.inverse_scale), pb,
+                                       tolerances.intersection, tolerances.tie);
 }
 
 }  // namespace diffpills::detail

@@ -301,12 +301,12 @@ class FacetSearch final : public NearNormalEdgePairs {
   const CoreOutline& a_;
   const CoreOutline& b_;
   double tolerance_;
-  // Relative to the tolerance, 1e-12 of the length the search works at (the frame's scene, or a
-  // speck pair's own: pair_frame.hpp, speck_scene): a value's rounding, a few ulps of it; and how
-  // far the edge-pair search's bounds are kept above what they bound, far above the rounding of
-  // the sums that form them. Relative to the scene where the radii make it, both exceeded a
-  // needle's width (4e-14 beside radii of 1), the hierarchies ruled no pair out, and two crossing
-  // needles of 64,000 vertices took 11 s.
+  // Relative to the tolerance, 1e-12 of the length the search works at (the frame's scene, or two
+  // polygons' own: pair_setup.hpp, search_tolerances): a value's rounding, a few ulps of it; and
+  // how far the edge-pair search's bounds are kept above what they bound, far above the rounding
+  // of the sums that form them. As constants of the scene where the radii make it, both exceeded
+  // a needle's width (4e-14 beside radii of 1), the hierarchies ruled no pair out, and two
+  // crossing needles of 64,000 vertices took 11 s.
   double value_rounding_, bound_slack_;
   Eigen::Vector3d offset_, z1_;
   DeepestFacet lowest_, best_;

@@ -89,7 +89,7 @@ struct DeepestFacet {
 enum class EdgePairVisits { kPruned, kEvery };
 
 // `tolerance`: ties and touching, in the frame's units; the search's rounding allowances are
-// relative to it (the frame's, or a speck pair's own: pair_frame.hpp, speck_scene).
+// relative to it (the frame's, or two polygons' own: pair_setup.hpp, search_tolerances).
 DeepestFacet deepest_facet(const CoreOutline& a, const CoreOutline& b, double tolerance,
                            EdgePairVisits visits = EdgePairVisits::kPruned);
 

@@ -4,8 +4,6 @@
 #include <limits>
 #include <vector>
 
-#include "pair_frame.hpp"
-
 namespace diffpills::detail {
 namespace {
 
@@ -88,29 +86,6 @@ bool add_arc(Window& window, const Arc& arc, Eigen::Index size) {
   return grew;
 }
 
-// How close to its support plane, per unit of |d|, a vertex must be to join a window: the tolerance
-// by which the sub-problems judge ties, so that every tie is in the windows (see below).
-//
-// Specks (pair_frame.hpp, speck_scene): that tolerance can exceed a core's width. Needles 4e-11
-// long and 4e-14 wide beside radii of 1 had every vertex within it of its support, the windows
-// took both polygons whole, and their sweep met nearly every edge pair when the needles crossed
-// each other's planes (1000:1 ellipses of 4x10^4 vertices: 1.6-1.9 s; with radius 0, 1 ms). The
-// radii play no part in which core points are closest, so the windows then judge ties as the frame
-// of the bare cores would (make_pair_frame without the radii): 1e-12 of the cores' own scene, or
-// 2e-12 of the larger core plus 64 ulps of that scene. A tie that the sub-problems take at the
-// scene's tolerance may then lie outside the windows; any two points of specks are within their
-// size of each other, 1e-9 of the scene, the bound of the swap and rigid-motion symmetry.
-double window_tie_tolerance(const PolygonView& a, const PolygonView& b,
-                            const PolygonPairFrame& frame, double tolerance, double tie_tolerance) {
-  const double scene_tolerance = std::max(tolerance, tie_tolerance);
-  const double speck = speck_scene(a.extent(), b.extent(), frame.b_origin_in_a.norm(), tolerance);
-  if (speck == 0.0) return scene_tolerance;
-  const double core_tolerance = 1e-12 * speck;
-  const double core_tie_tolerance = 2e-12 * std::max(a.extent(), b.extent()) +
-                                    64 * std::numeric_limits<double>::epsilon() * speck;
-  return std::min(scene_tolerance, std::max(core_tolerance, core_tie_tolerance));
-}
-
 }  // namespace
 
 // GJK's idea with exact steps. The closest pair of two windows' convex hulls (sub-polygons of A
@@ -125,7 +100,7 @@ double window_tie_tolerance(const PolygonView& a, const PolygonView& b,
 // ends; it ends when nothing is added, with a certified pair whose ties are all in the windows.
 // slack = max(tolerance, tie_tolerance) |d|: the frame's intersection tolerance, or its tie
 // tolerance (pair_frame.hpp) if larger, by which the sub-problems judge ties, so that every tie
-// is in the windows; for specks whose radii make the scene, their own (window_tie_tolerance).
+// is in the windows (for two polygons the bare cores' own, pair_setup.hpp: search_tolerances).
 //
 // d's rounding. p1 and p2 carry errors of a few ulps of their own size, so d is off by up to
 // delta = 64 eps (|p1| + |p2|), and a polygon's values x . d by up to 2 extent delta: for a gap far
@@ -146,7 +121,6 @@ std::array<ClosestFeature, 2> closest_separated_by_windows(const PolygonView& a,
                                                            const PolygonPairFrame& frame,
                                                            const CarriedPolygon<PolygonView>& W,
                                                            double tolerance, double tie_tolerance) {
-  const double window_tolerance = window_tie_tolerance(a, b, frame, tolerance, tie_tolerance);
   Window window_a(a.size()), window_b(b.size());
   // First guess: the supports along the line between the body origins (each inside its polygon).
   Eigen::Vector3d d = frame.b_origin_in_a;
@@ -166,7 +140,7 @@ std::array<ClosestFeature, 2> closest_separated_by_windows(const PolygonView& a,
     const Eigen::Vector3d p1 = sides[0].body_point;
     const Eigen::Vector3d p2 = frame.b_in_a * sides[1].body_point + frame.b_origin_in_a;
     d = p2 - p1;
-    const double slack = window_tolerance * d.norm();
+    const double slack = std::max(tolerance, tie_tolerance) * d.norm();
     const double rounding = 64 * std::numeric_limits<double>::epsilon() * (p1.norm() + p2.norm());
     const double margin_a = 2.0 * (slack + 2.0 * a.extent() * rounding);
     const double margin_b = 2.0 * (slack + 2.0 * b.extent() * rounding);

@@ -1,13 +1,13 @@
 // The public signed-distance queries (signed_distance.hpp). Each solves the closest-point problem
-// with the proximity's exact fast path (pair_setup.hpp); cores apart by more than the frame's
-// tolerance are done then. Intersecting cores go on to the nearest facet of their Minkowski
+// with the proximity's exact fast path (pair_setup.hpp); cores apart by more than the tolerance
+// they are searched with (the frame's; two polygons' own, pair_setup.hpp: search_tolerances) are
+// done then. Intersecting cores go on to the nearest facet of their Minkowski
 // difference (penetration.hpp), whose witnesses replace the closest points unless the facet is
 // within the tolerance of the origin (touching, or a flat D), where the closest points, the
 // middle of the cores' intersection, serve as they are.
 #include "diffpills/signed_distance.hpp"
 
 #include <Eigen/Geometry>
-#include <algorithm>
 #include <optional>
 #include <type_traits>
 #include <variant>
@@ -93,7 +93,8 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   const Eigen::Vector3d x1 = pa.r + pa.attitude.matrix() * solution.sides[0].body_point;
   const Eigen::Vector3d x2 = pb.r + pb.attitude.matrix() * solution.sides[1].body_point;
   const double apart = (x2 - x1).norm();
-  if (apart > frame.tolerance) {
+  const double tolerance = detail::search_tolerances(a, pa, b, pb, frame).intersection;
+  if (apart > tolerance) {
     solution.gap = apart;
     solution.source = detail::points_normal_source(pa, solution.sides[0], pb, solution.sides[1],
                                                    x2 - x1, frame.unit);
@@ -104,12 +105,7 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   const std::optional<PolygonView> view_b = polygon_view(b, frame);
   const CoreOutline outline_a = outline(a, pa, view_a ? &*view_a : nullptr);
   const CoreOutline outline_b = outline(b, pb, view_b ? &*view_b : nullptr);
-  // Specks (pair_frame.hpp) are searched at their own scale: at the scene's, the search's
-  // allowances exceed their width and its hierarchies rule no edge pair out.
-  const double speck = detail::speck_scene(pa.size, pb.size, (pb.r - pa.r).norm(), frame.tolerance);
-  const double search_tolerance =
-      speck > 0.0 ? std::min(frame.tolerance, 1e-12 * speck) : frame.tolerance;
-  const DeepestFacet facet = detail::deepest_facet(outline_a, outline_b, search_tolerance);
+  const DeepestFacet facet = detail::deepest_facet(outline_a, outline_b, tolerance);
   solution.penetrating = true;
   solution.source = facet_source(facet, outline_a, outline_b);
   if (facet.kind == DeepestFacet::Kind::kNone) {
