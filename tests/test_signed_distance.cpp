@@ -611,5 +611,49 @@ TEST(SignedDistance, ContinuousAcrossTouching) {
   }
 }
 
+// Cores far smaller than the radii that make the scene (a hostile review): a capsule 4e-11 long
+// lying 2e-12 .. 1e-14 above a needle 4e-11 by 4e-14, and above the same capsule, radii 1. At the
+// scene's tolerance (1e-12) the penetration search's allowances exceeded the gap, and the signed
+// gap came out -4.001e-13 in one order of the shapes and +3.999e-13 in the other; the cores are
+// searched at their own tolerances, so the gap is the exact one to the rounding of the radii (the
+// distance is gap - 2) in both orders, and the cores do not penetrate.
+TEST(SignedDistance, CoresFarSmallerThanTheirRadiiKeepTheirGap) {
+  const double length = 4e-11;
+  Eigen::MatrixX2d C(4, 2);
+  C << 1, 0, -1, 0, 0, 1, 0, -1;
+  const PaddedPolygon needle(
+      C, Eigen::Vector4d(length / 2, length / 2, length / 2000, length / 2000), 1.0);
+  const Capsule capsule(length, 1.0);
+  const double s2 = std::sqrt(0.5);
+  for (const double gap : {2e-12, 9e-13, 4e-13, 1e-13, 1e-14}) {
+    SCOPED_TRACE(::testing::Message() << "gap " << gap);
+    const Pose above(Eigen::Vector3d(0, 0, gap), Eigen::Vector4d(s2, 0, 0, s2));
+    const Pose below(Eigen::Vector3d::Zero(), kIdentity);
+    const std::array<SignedDistance, 4> answers = {
+        signed_distance(capsule, above, needle, below),
+        signed_distance(needle, below, capsule, above),
+        signed_distance(capsule, above, capsule, Pose(Eigen::Vector3d::Zero(), kIdentity)),
+        signed_distance(capsule, Pose(Eigen::Vector3d::Zero(), kIdentity), capsule, above)};
+    for (const SignedDistance& sd : answers) {
+      EXPECT_NEAR(sd.distance + 2.0, gap, 4e-16);
+      EXPECT_FALSE(sd.penetrating);
+      EXPECT_NEAR(std::abs(sd.normal.z()), 1.0, 1e-12);
+    }
+  }
+  // A capsule through the needle's middle, crossing it at 60 degrees, 1e-14 below its top: the
+  // depth is the needle's half width less that (the way out along the needle's width, 1.9e-14),
+  // found as for radius 0.
+  const Pose crossing(Eigen::Vector3d(0, 0, 0), about(M_PI / 3, 1, 0, 0));
+  const PaddedPolygon bare(C, Eigen::Vector4d(length / 2, length / 2, length / 2000, length / 2000),
+                           0.0);
+  const SignedDistance bare_answer = signed_distance(Capsule(length, 0.0), crossing, bare, Pose());
+  for (const bool swapped : {false, true}) {
+    const SignedDistance sd = swapped ? signed_distance(needle, Pose(), capsule, crossing)
+                                      : signed_distance(capsule, crossing, needle, Pose());
+    EXPECT_TRUE(sd.penetrating);
+    EXPECT_NEAR(sd.distance + 2.0, bare_answer.distance, 4e-16) << swapped;
+  }
+}
+
 }  // namespace
 }  // namespace diffpills::testing

@@ -35,7 +35,9 @@
 //     gives the interval, and for slopes within a factor of two (a regular many-sided polygon
 //     pointing its vertex down the slope) the vertex, the one closest point.
 //     The optimal set is found from the candidates that tie: distances within 2e-12 of the larger
-//     core's size plus 64 ulps of the scene's size, and the point candidate on the interval.
+//     core's size plus 64 ulps of the scene's size, and the point candidate on the interval. (The
+//     cores are searched without their radii: where the radii make the scene, its size here is
+//     that of the cores' own, the larger core and the distance between the body origins.)
 //     Shapes far apart compared to their size (a distance V, sizes h) have their closest points
 //     to within the scene's rounding only: beyond V ~ 1e6 h neighbouring candidates' distances
 //     differ by less than the tie tolerance.

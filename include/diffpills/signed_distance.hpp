@@ -47,7 +47,9 @@
 //   - Cores crossing nearly coplanar: D is thin, and facets within the tolerance of the nearest
 //     one in depth can lie far apart along it. Only a facet whose nearest point lies on it is
 //     taken, so the witnesses always lie on the two cores (penetration.hpp).
-//   - Tolerances are relative (1e-12 of the scene's size), as for proximity(), and every input
+//   - Tolerances are relative, as for proximity(): 1e-12 of the scene's size, or of the cores'
+//     own (the larger core and the distance between the body origins) where the radii make the
+//     scene, since the radii play no part in the cores' gap and depth; and every input
 //     proximity() accepts is answered at every magnitude; scaling all lengths by 2^k scales
 //     distance and the points by 2^k, the gradient's quaternion part by 2^k, exactly.
 //

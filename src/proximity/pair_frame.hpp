@@ -38,16 +38,17 @@ struct PairFrame {
 };
 
 // The tolerances the bare cores would be solved with, in this frame's units: those of
-// make_pair_frame without the radii, 1e-12 of the cores' own scene (the larger core size and
-// the distance between the body origins) and 2e-12 of the larger core plus 64 ulps of that scene,
+// make_pair_frame without the radii, 1e-12 of the cores' own scene (the larger core size and the
+// distance between the body origins) and 2e-12 of the larger core plus 64 ulps of that scene,
 // where they are finer than the frame's. They are where the radii make the scene: the coordinates
 // of a pair's cores, taken from shape a's body origin, reach only the cores' scene, and their
 // rounding with it; the radii play no part in which core points are closest. Searches whose pruning
 // is only as fine as the tolerance need them there: a needle 4e-11 long and 4e-14 wide beside radii
 // of 1 lies wholly within 1e-12 of the scene of any plane along it, and discs 5e-10 across beside
 // radii of 1 have ~1,400 of 10^5 vertices within it of a support line (polygon_windows.cpp,
-// penetration.hpp). Cores below 1e-100 of the frame's units keep the frame's: products of their
-// coordinates lose digits to underflow.
+// penetration.hpp). Cores below 1e-100 of the frame's units keep the frame's: the searches form
+// products of two core lengths (squared distances, values along a direction), which must stay far
+// from underflow (below ~1e-154 they lose every digit).
 struct CoreTolerances {
   double intersection = 0.0;
   double tie = 0.0;

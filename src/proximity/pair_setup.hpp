@@ -32,36 +32,34 @@ inline Sides fast_sides(const Capsule&, const PosedCore& pa, const Capsule&, con
                         const PairFrame&) {
   return detail::solve_capsule_capsule(pa, pb);
 }
-inline Sides fast_sides(const Capsule&, const PosedCore& pa, const PaddedPolygon& b,
-                        const PosedCore& pb, const PairFrame& frame) {
-  return detail::solve_capsule_polygon(pa, PolygonView(b, frame.inverse_scale), pb, frame.tolerance,
-                                       frame.tie_tolerance);
-}
-inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Capsule&,
-                        const PosedCore& pb, const PairFrame& frame) {
-  const Sides swapped = detail::solve_capsule_polygon(pb, PolygonView(a, frame.inverse_scale), pa,
-                                                      frame.tolerance, frame.tie_tolerance);
-  return {swapped[1], swapped[0]};
-}
-
-// The tolerances a pair's cores are searched with: the frame's, except for two polygons, which
-// are searched at the bare cores' own (core_tolerances, pair_frame.hpp). Capsule pairs are solved
-// in closed form and a capsule against a k-gon in O(k) whatever the tolerance; two polygons are
-// searched in windows and hierarchies whose pruning is only as fine as it.
-template <class ShapeA, class ShapeB>
-CoreTolerances search_tolerances(const ShapeA&, const PosedCore&, const ShapeB&, const PosedCore&,
-                                 const PairFrame& frame) {
-  return {frame.tolerance, frame.tie_tolerance};
-}
-inline CoreTolerances search_tolerances(const PaddedPolygon&, const PosedCore& pa,
-                                        const PaddedPolygon&, const PosedCore& pb,
+// The tolerances a pair's cores are searched with: the bare cores' own (core_tolerances,
+// pair_frame.hpp), which are the frame's unless the radii make the scene. The radii play no part
+// in which core points are closest, and searches whose pruning is only as fine as the tolerance
+// (two polygons' windows and hierarchies, pair_frame.hpp) would otherwise stall on cores far
+// smaller than their radii; the penetration search's allowances follow its tolerance
+// (penetration.hpp), and at the scene's a capsule 4e-13 above a needle beside radii of 1 got a
+// signed gap of -4e-13 in one order of the shapes and +4e-13 in the other.
+inline CoreTolerances search_tolerances(const PosedCore& pa, const PosedCore& pb,
                                         const PairFrame& frame) {
   return core_tolerances(frame, pa.size, pb.size, (pb.r - pa.r).norm());
 }
 
+inline Sides fast_sides(const Capsule&, const PosedCore& pa, const PaddedPolygon& b,
+                        const PosedCore& pb, const PairFrame& frame) {
+  const CoreTolerances tolerances = search_tolerances(pa, pb, frame);
+  return detail::solve_capsule_polygon(pa, PolygonView(b, frame.inverse_scale), pb,
+                                       tolerances.intersection, tolerances.tie);
+}
+inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Capsule&,
+                        const PosedCore& pb, const PairFrame& frame) {
+  const CoreTolerances tolerances = search_tolerances(pa, pb, frame);
+  const Sides swapped = detail::solve_capsule_polygon(pb, PolygonView(a, frame.inverse_scale), pa,
+                                                      tolerances.intersection, tolerances.tie);
+  return {swapped[1], swapped[0]};
+}
 inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const PaddedPolygon& b,
                         const PosedCore& pb, const PairFrame& frame) {
-  const CoreTolerances tolerances = search_tolerances(a, pa, b, pb, frame);
+  const CoreTolerances tolerances = search_tolerances(pa, pb, frame);
   return detail::solve_polygon_polygon(PolygonView(a, frame.inverse_scale), pa,
                                        PolygonView(b, frame.inverse_scale), pb,
                                        tolerances.intersection, tolerances.tie);

@@ -270,7 +270,7 @@ void offer_edge_pair(const Segment& edge, const EdgeBound& a_bound, Eigen::Index
 // allocation-free up to 32 vertices. Only the pairs whose lower bound is below the best distance
 // so far plus `band` reach the exact solver, the bound starting from an achievable distance:
 // every pair within `band` of the closest, each one that the choice between a point and an
-// interval can take (Best::choice; band is the larger of the tolerance and the tie tolerance), so
+// interval can take (Best::choice; band is the tie tolerance, beyond which it takes none), so
 // the answer does not depend on which bounds ruled the others out, and few others. On a CPU with
 // vectors of 4 doubles or more the bounds are segment_bounds.hpp's, the pairs' distances to
 // their margin (100 times the tolerance, far above their error) from the vector kernel, starting
@@ -412,7 +412,7 @@ Eigen::Vector2d spread_axis(const SmallBuffer<EdgeBound>& bounds) {
 template <class Polygon>
 void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
                  const SmallBuffer<Segment>& b_edges, const SmallBuffer<EdgeBound>& b_bounds,
-                 double tolerance, Best& best) {
+                 double tolerance, double tie_tolerance, Best& best) {
   const Eigen::Index kb = W.size();
   Eigen::AlignedBox2d box_a;
   Eigen::AlignedBox3d box_b;
@@ -426,9 +426,10 @@ void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
     sweep_specks(a, W, b_edges, apart.normalized(), slack, best);
     return;
   }
-  // Specks near each other (their radii make the scene): the sweep below with the band 0 of
+  // Specks near each other (their radii make the scene, and they keep its tolerances: cores below
+  // 1e-100 of the frame's units, pair_frame.hpp): the sweep below with the band 0 of
   // sweep_specks, for the same reason.
-  const double band = specks ? 0.0 : tolerance;
+  const double band = specks ? 0.0 : tie_tolerance;
   const Eigen::Vector2d axis = spread_axis(b_bounds);
   const auto along = [&axis](const Eigen::Vector3d& point) { return axis.dot(point.head<2>()); };
   // Visits the B features in `order` from the first at or after x outward both ways, while
@@ -536,9 +537,9 @@ std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
   // Whole polygons (PolygonView) always get every pair: the fast path sends only small ones here,
   // and the tests compare the windows with this full enumeration.
   if (std::is_same_v<Polygon, SubPolygon> && a.size() * kb > kSweepLimit) {
-    sweep_pairs(a, W, b_edges, edge_bounds(b_edges, W), tolerance, best);
+    sweep_pairs(a, W, b_edges, edge_bounds(b_edges, W), tolerance, tie_tolerance, best);
   } else {
-    visit_all_pairs(a, W, X, b_edges, tolerance, std::max(tolerance, tie_tolerance), best);
+    visit_all_pairs(a, W, X, b_edges, tolerance, tie_tolerance, best);
   }
   const auto sides_of = [&](const Candidate& c) { return sides(c, a, b, W, X); };
   return sides(best.choice(tolerance, tie_tolerance, sides_of), a, b, W, X);

@@ -1,10 +1,10 @@
 // The public signed-distance queries (signed_distance.hpp). Each solves the closest-point problem
 // with the proximity's exact fast path (pair_setup.hpp); cores apart by more than the tolerance
-// they are searched with (the frame's; two polygons' own, pair_setup.hpp: search_tolerances) are
-// done then. Intersecting cores go on to the nearest facet of their Minkowski
-// difference (penetration.hpp), whose witnesses replace the closest points unless the facet is
-// within the tolerance of the origin (touching, or a flat D), where the closest points, the
-// middle of the cores' intersection, serve as they are.
+// they are searched with (the cores' own, pair_setup.hpp: search_tolerances) are done then.
+// Intersecting cores go on to the nearest facet of their Minkowski difference (penetration.hpp),
+// whose witnesses replace the closest points unless the facet is within the tolerance of the origin
+// (touching, or a flat D), where the closest points, the middle of the cores' intersection, serve
+// as they are.
 #include "diffpills/signed_distance.hpp"
 
 #include <Eigen/Geometry>
@@ -93,7 +93,7 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   const Eigen::Vector3d x1 = pa.r + pa.attitude.matrix() * solution.sides[0].body_point;
   const Eigen::Vector3d x2 = pb.r + pb.attitude.matrix() * solution.sides[1].body_point;
   const double apart = (x2 - x1).norm();
-  const double tolerance = detail::search_tolerances(a, pa, b, pb, frame).intersection;
+  const double tolerance = detail::search_tolerances(pa, pb, frame).intersection;
   if (apart > tolerance) {
     solution.gap = apart;
     solution.source = detail::points_normal_source(pa, solution.sides[0], pb, solution.sides[1],
@@ -109,7 +109,7 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   solution.penetrating = true;
   solution.source = facet_source(facet, outline_a, outline_b);
   if (facet.kind == DeepestFacet::Kind::kNone) {
-    solution.normal = fallback_normal(outline_a, outline_b, frame.tolerance);
+    solution.normal = fallback_normal(outline_a, outline_b, tolerance);
     return solution;  // s = 0: the segments (or points) meet
   }
   solution.gap = -facet.depth;
