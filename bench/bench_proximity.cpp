@@ -291,6 +291,16 @@ BENCHMARK(CapsulePolygon_Vertices)
     ->Complexity()
     ->Unit(benchmark::kMicrosecond);
 
+// The large-polygon cases' vertex counts, 1,024 to 65,536 by fours and 10^5, in milliseconds
+// with the growth fitted.
+void large_polygon_sizes(benchmark::internal::Benchmark* benchmark) {
+  benchmark->RangeMultiplier(4)
+      ->Range(1024, 65536)
+      ->Arg(100000)
+      ->Complexity()
+      ->Unit(benchmark::kMillisecond);
+}
+
 // Nearly parallel faces (a hostile review's stall): two unit-circumradius k-gons, one 0.5 above
 // the other and tilted 1e-11 rad about x, so that thousands of vertices of each tie within the
 // windows' margin and the windows' pairs are swept (separated_polygons.cpp).
@@ -301,12 +311,7 @@ void PolygonPolygon_NearlyParallel(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(proximity(polygon, below, polygon, above));
   state.SetComplexityN(count);
 }
-BENCHMARK(PolygonPolygon_NearlyParallel)
-    ->RangeMultiplier(4)
-    ->Range(1024, 65536)
-    ->Arg(100000)
-    ->Complexity()
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(PolygonPolygon_NearlyParallel)->Apply(large_polygon_sizes);
 
 // Two unit-circumradius k-gons 1e13 and 1e30 times their size apart (in the plane, along a
 // diagonal), alternately: far beyond the point where the intersection tolerance (1e-12 of the
@@ -325,12 +330,7 @@ void PolygonPolygon_FarApart(benchmark::State& state) {
   }
   state.SetComplexityN(count);
 }
-BENCHMARK(PolygonPolygon_FarApart)
-    ->RangeMultiplier(4)
-    ->Range(1024, 65536)
-    ->Arg(100000)
-    ->Complexity()
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(PolygonPolygon_FarApart)->Apply(large_polygon_sizes);
 
 // Two unit-circumradius k-gons 1e8 apart, facing, the second tilted 1e-5 rad (a hostile review:
 // 0.18 s at 2,000 vertices, 8.3 s at 16,000): their features tie only within 64 ulps of the
@@ -343,12 +343,7 @@ void PolygonPolygon_FarApartTilted(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(proximity(polygon, origin, polygon, above));
   state.SetComplexityN(count);
 }
-BENCHMARK(PolygonPolygon_FarApartTilted)
-    ->RangeMultiplier(4)
-    ->Range(1024, 65536)
-    ->Arg(100000)
-    ->Complexity()
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(PolygonPolygon_FarApartTilted)->Apply(large_polygon_sizes);
 
 // Needles thinner than the tolerance their radii set: two 1000:1 ellipses of k vertices, 4e-11
 // long and 4e-14 wide, radius 1, the second turned a quarter about y and 3e-11 beside the first, so
@@ -379,12 +374,7 @@ void PolygonPolygon_Needles(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(proximity(a, origin, b, beside));
   state.SetComplexityN(count);
 }
-BENCHMARK(PolygonPolygon_Needles)
-    ->RangeMultiplier(4)
-    ->Range(1024, 65536)
-    ->Arg(100000)
-    ->Complexity()
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(PolygonPolygon_Needles)->Apply(large_polygon_sizes);
 // The same needles crossing (the second 1e-14 beside the first's middle, through its plane): the
 // signed distance's penetration search, at the needles' own tolerance (penetration.hpp).
 void PolygonPolygon_SignedDistanceNeedles(benchmark::State& state) {
@@ -394,12 +384,7 @@ void PolygonPolygon_SignedDistanceNeedles(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(signed_distance(a, origin, b, crossing));
   state.SetComplexityN(count);
 }
-BENCHMARK(PolygonPolygon_SignedDistanceNeedles)
-    ->RangeMultiplier(4)
-    ->Range(1024, 65536)
-    ->Arg(100000)
-    ->Complexity()
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(PolygonPolygon_SignedDistanceNeedles)->Apply(large_polygon_sizes);
 
 // Two k-gons crossing (the signed distance in penetration): the unit-circumradius k-gon at the
 // origin, the 0.7 one turned off its plane by 30 to 90 degrees about a random in-plane axis, its
@@ -454,12 +439,7 @@ void PolygonPolygon_SignedDistanceNearlyParallel(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(signed_distance(a, flat, b, tilted));
   state.SetComplexityN(count);
 }
-BENCHMARK(PolygonPolygon_SignedDistanceNearlyParallel)
-    ->RangeMultiplier(4)
-    ->Range(1024, 65536)
-    ->Arg(100000)
-    ->Complexity()
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(PolygonPolygon_SignedDistanceNearlyParallel)->Apply(large_polygon_sizes);
 
 // proximity_batch over N pose pairs (the first argument: 10^4, 10^5, 10^6) with 1 and 2 threads
 // (the second), wall-clock time; the rows cycle through the 1,024 pose pairs above.
