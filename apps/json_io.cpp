@@ -287,8 +287,9 @@ Output to_json(const std::array<ShapeGradient, 2>& shape_gradient) {
     const auto& polygon = std::get<PolygonShapeGradient>(gradient);
     if (!polygon.C.allFinite() || !polygon.d.allFinite() || !std::isfinite(polygon.radius)) {
       throw std::invalid_argument(std::string("shape_gradient: ") + shape +
-                                  "'s gradient is beyond the double range (rows of C far "
-                                  "shorter than 1e-300?); ask without \"shape_gradient\"");
+                                  "'s gradient is beyond the double range (rows of C "
+                                  "shorter than ~1e-308 of the shapes' gap?); ask without "
+                                  "\"shape_gradient\" or rescale the rows");
     }
     return {{"C", rows(polygon.C)}, {"d", list(polygon.d)}, {"radius", polygon.radius}};
   };

@@ -52,7 +52,7 @@ An answer:
                                            capsule, {"C": m rows of 2, "d": [m], "radius"} for
                                            a polygon, rows as given, redundant rows 0; an
                                            error if beyond the double range: rows of C
-                                           shorter than ~1e-300)
+                                           shorter than ~1e-308 of the shapes' gap)
   The signed distance is the gap between the padded shapes, or minus their penetration depth.
   A line that is not a valid query is answered {"error": "<field>: <what is wrong>"}
   and the following lines are still answered.

@@ -23,8 +23,9 @@
 //     repeat the first-order answer bit for bit (the Jacobians too) and give a finite, exactly
 //     symmetric Hessian (and a finite normal Jacobian), which proximity_with_hessian repeats
 //     with its Proximity (every field ==); two capsules' Hessian agrees with the
-//     general pipeline's; the shape gradients are finite, with a row per given row and the same
-//     phi / distance as the plain calls.
+//     general pipeline's; the shape gradients have a row per given row, no NaN and the same
+//     phi / distance as the plain calls, and are finite except where a polygon row's 1 / |C_i|
+//     carries them beyond the double range (confirmed with the rows rescaled to unit length).
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <Eigen/Core>
@@ -286,7 +287,9 @@ void check_signed_distance(const Shape& a, const Pose& pose_a, const Shape& b, c
   }
 }
 
-bool finite_shape_gradient(const diffpills::ShapeGradient& gradient, const Shape& shape) {
+// A shape's gradient has the shape's alternative, a row per given row and no NaN; a capsule's and
+// a polygon's radius entry are finite.
+bool well_formed(const diffpills::ShapeGradient& gradient, const Shape& shape) {
   if (const auto* capsule = std::get_if<diffpills::CapsuleShapeGradient>(&gradient)) {
     return std::holds_alternative<Capsule>(shape) && std::isfinite(capsule->length) &&
            std::isfinite(capsule->radius);
@@ -294,8 +297,73 @@ bool finite_shape_gradient(const diffpills::ShapeGradient& gradient, const Shape
   const auto& polygon = std::get<diffpills::PolygonShapeGradient>(gradient);
   const auto* given = std::get_if<PaddedPolygon>(&shape);
   return given != nullptr && polygon.C.rows() == given->constraint_matrix().rows() &&
-         polygon.d.size() == polygon.C.rows() && polygon.C.allFinite() && polygon.d.allFinite() &&
+         polygon.d.size() == polygon.C.rows() && !polygon.C.hasNaN() && !polygon.d.hasNaN() &&
          std::isfinite(polygon.radius);
+}
+
+bool finite(const diffpills::ShapeGradient& gradient) {
+  const auto* polygon = std::get_if<diffpills::PolygonShapeGradient>(&gradient);
+  return polygon == nullptr || (polygon->C.allFinite() && polygon->d.allFinite());
+}
+
+// The polygon with every row rescaled by an exact power of two 2^exponents(i) to a length in
+// [1/2, 1): the same half-planes, so the same polygon.
+PaddedPolygon with_unit_rows(const PaddedPolygon& polygon, Eigen::VectorXi& exponents) {
+  Eigen::MatrixX2d C = polygon.constraint_matrix();
+  Eigen::VectorXd d = polygon.constraint_offsets();
+  exponents.resize(C.rows());
+  for (Eigen::Index i = 0; i < C.rows(); ++i) {
+    int length_exponent = 0;
+    std::frexp(std::hypot(C(i, 0), C(i, 1)), &length_exponent);
+    exponents(i) = -length_exponent;
+    C(i, 0) = std::ldexp(C(i, 0), exponents(i));
+    C(i, 1) = std::ldexp(C(i, 1), exponents(i));
+    d(i) = std::ldexp(d(i), exponents(i));
+  }
+  return PaddedPolygon(C, d, polygon.radius());
+}
+
+// `given` is `unit`, the gradient of the same polygon with its rows rescaled by 2^exponents,
+// scaled back: the gradient of a row scales as 1 / |C_i|, so given = 2^exponent_i unit, which is
+// +-infinity exactly where that exceeds the largest double (to rounding at the border).
+bool scales_back(double given, double unit, int exponent) {
+  const double expected = std::ldexp(unit, exponent);
+  const double largest = std::numeric_limits<double>::max();
+  if (std::isinf(given)) {
+    return std::signbit(given) == std::signbit(unit) &&
+           std::abs(unit) >= std::ldexp(largest * (1.0 - 1e-9), -exponent);
+  }
+  return std::abs(given - expected) <=
+         1e-9 * std::abs(expected) + std::numeric_limits<double>::min();
+}
+
+// Shape gradients (shape_gradient.hpp): well formed, and finite except in polygon rows whose
+// 1 / |C_i| carries them beyond the double range, where they are +-infinity (the command answers
+// those with an error). An infinite entry is confirmed by asking again with that polygon's rows
+// rescaled to unit length: the same answer, finite, that scales back to the infinity.
+template <typename Answer, typename Ask>
+void check_shape_gradients(const Answer& answer, const Shape& a, const Shape& b, const Ask& ask,
+                           const char* what) {
+  const std::array<const Shape*, 2> shapes = {&a, &b};
+  for (std::size_t side = 0; side < 2; ++side) {
+    const diffpills::ShapeGradient& gradient = answer.shape_gradient[side];
+    check(well_formed(gradient, *shapes[side]), what);
+    if (finite(gradient)) continue;
+    Eigen::VectorXi exponents;
+    const PaddedPolygon unit_rows =
+        with_unit_rows(std::get<PaddedPolygon>(*shapes[side]), exponents);
+    const Answer again = side == 0 ? ask(unit_rows, b) : ask(a, unit_rows);
+    check(again.points == answer.points, "rows rescaled to unit length: the same points");
+    const auto& given = std::get<diffpills::PolygonShapeGradient>(gradient);
+    const auto& unit = std::get<diffpills::PolygonShapeGradient>(again.shape_gradient[side]);
+    check(finite(again.shape_gradient[side]), "rows rescaled to unit length: a finite gradient");
+    for (Eigen::Index i = 0; i < given.d.size(); ++i) {
+      check(scales_back(given.d(i), unit.d(i), exponents(i)) &&
+                scales_back(given.C(i, 0), unit.C(i, 0), exponents(i)) &&
+                scales_back(given.C(i, 1), unit.C(i, 1), exponents(i)),
+            "an infinite shape gradient is the rescaled rows' beyond the double range", given.d(i));
+    }
+  }
 }
 
 // Two capsules in the generic case take the fused pass (src/proximity/capsule_proximity.hpp) for
@@ -356,17 +424,23 @@ void check_second_order(const Shape& a, const Pose& pose_a, const Shape& b, cons
       diffpills::proximity_shape_gradient(a, pose_a, b, pose_b);
   check(shape_phi.phi == proximity.phi, "proximity_shape_gradient repeats phi",
         shape_phi.phi - proximity.phi);
-  check(finite_shape_gradient(shape_phi.shape_gradient[0], a) &&
-            finite_shape_gradient(shape_phi.shape_gradient[1], b),
-        "shape gradients of phi are finite, one row per given row");
+  check_shape_gradients(
+      shape_phi, a, b,
+      [&](const Shape& a_again, const Shape& b_again) {
+        return diffpills::proximity_shape_gradient(a_again, pose_a, b_again, pose_b);
+      },
+      "shape gradients of phi: one row per given row, no NaN");
   const diffpills::SignedDistanceShapeGradient shape_distance =
       diffpills::signed_distance_shape_gradient(a, pose_a, b, pose_b);
   check(shape_distance.distance == first.distance,
         "signed_distance_shape_gradient repeats distance",
         shape_distance.distance - first.distance);
-  check(finite_shape_gradient(shape_distance.shape_gradient[0], a) &&
-            finite_shape_gradient(shape_distance.shape_gradient[1], b),
-        "shape gradients of the distance are finite, one row per given row");
+  check_shape_gradients(
+      shape_distance, a, b,
+      [&](const Shape& a_again, const Shape& b_again) {
+        return diffpills::signed_distance_shape_gradient(a_again, pose_a, b_again, pose_b);
+      },
+      "shape gradients of the distance: one row per given row, no NaN");
 }
 
 // Every query on one valid pair, with the invariants above.

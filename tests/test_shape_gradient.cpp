@@ -263,6 +263,24 @@ TEST(ShapeGradient, RowsOfAnyScaleGetTheirGradient) {
   EXPECT_FALSE(g.d.hasNaN());
   EXPECT_FALSE(g.C.hasNaN());
   EXPECT_EQ(g.d(0), -std::numeric_limits<double>::infinity());
+  // Rows of normal length overflow too where the scene is large: rows of 2^-960 with the sphere
+  // 2^80 away give multipliers of about 2^81 / 2^-960 (fuzz_proximity's finding: a row of
+  // 8e-281 in a scene of 1e70). Rescaled by 2^960 the rows give the finite multipliers.
+  const double row = std::ldexp(1.0, -960);
+  const double far = std::ldexp(1.0, 80);
+  const Pose far_beside(far * beside.r(), beside.q());
+  const PaddedPolygon short_rows(row * C, Eigen::Vector4d::Constant(row), 0.1);
+  const auto overflowing = std::get<PolygonShapeGradient>(
+      proximity_shape_gradient(short_rows, Pose(), sphere, far_beside).shape_gradient[0]);
+  const auto finite = std::get<PolygonShapeGradient>(
+      proximity_shape_gradient(unit, Pose(), sphere, far_beside).shape_gradient[0]);
+  ASSERT_TRUE(finite.d.allFinite() && finite.C.allFinite());
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(overflowing.d(i), std::ldexp(finite.d(i), 960)) << i;
+    EXPECT_EQ(overflowing.C(i, 0), std::ldexp(finite.C(i, 0), 960)) << i;
+    EXPECT_EQ(overflowing.C(i, 1), std::ldexp(finite.C(i, 1), 960)) << i;
+  }
+  EXPECT_EQ(overflowing.d(0), -std::numeric_limits<double>::infinity());
 }
 
 TEST(ShapeGradient, AnalyticCases) {

@@ -25,8 +25,11 @@
 // covers edges too: at a point inside edge j, -g is parallel to n_j and the other mu is 0; inside
 // the face g = 0 and every mu is 0. Rows that are redundant (dropped by the polygon's reduction)
 // get 0, and of rows given twice the first. d/dd_i and d/dC_i scale as 1 / |C_i|: for a row given
-// with |C_i| below ~1e-308 of mu_j (a subnormal row in a scene of unit size) they exceed the
-// largest double, and are then +-infinity (never NaN); the polygon's own answers are exact.
+// with |C_i| below ~1e-308 of mu_j (a subnormal row in a scene of unit size, or a row of 1e-281
+// with the shapes 1e70 apart) they exceed the largest double, and are then +-infinity (never
+// NaN), 2^k times the finite gradient of the row rescaled by 2^k; the polygon's own answers are
+// exact. The command answers such a line with an error naming shape_gradient (JSON has no
+// infinity).
 //
 // A capsule core is {r + Q [t; 0; 0] : -L/2 <= t <= L/2}: with g = a . w (a the world axis), the
 // multipliers of t <= L/2 and -t <= L/2 give d/dL = g t / L at an end and 0 inside, which is

@@ -1376,7 +1376,9 @@ second derivatives of the distance with respect to [r_a, q_a, r_b, q_b].)");
       py::arg("method") = "default",
       R"(As proximity, plus shape_gradient: the derivatives of phi with respect to each shape's own
 parameters, ({"length", "radius"} of a capsule, {"C" (m, 2), "d" (m,), "radius"} of a polygon;
-rows as given, a redundant row 0), by the envelope theorem.)");
+rows as given, a redundant row 0), by the envelope theorem. A row's entries scale as 1 / |C_i|
+and are +-inf where that exceeds the double range (rows shorter than ~1e-308 of the shapes' gap),
+never NaN.)");
   m.def(
       "signed_distance_shape_gradient",
       [](const py::handle& a, const py::handle& pose_a, const py::handle& b,
