@@ -207,6 +207,66 @@ TEST(OptimalSet, BoxEdgeOnATable) {
                 {0, 0.2, 0});
 }
 
+// A box face standing on a table within the tolerance, its bottom edge tilted a few picoradians
+// (past the 1e-12 of parallel planes), 1e-12 above the table at its middle: the planes cross on a
+// line that runs along the edge, where the edge's height of ~1e-12 over the tilt puts it, and the
+// middle of the cores' intersection is taken on it with one polygon grown by the tolerance. Which
+// polygon that is decided the answer: the two orders gave points up to 0.6 apart (a hostile
+// review). Both orders now solve the same problem (pair_setup.hpp, solve_b_as_a): the points
+// swap and the gradient permutes to rounding. A rigid motion, or the table's quaternion negated,
+// keeps the roles and moves the crossing only by the rounding of the heights over the tilt,
+// ~1e-16 / tilt (the problem's own conditioning), not by the tolerance over the tilt. The box is
+// a 2 x 1 face, or the table's own square (identical polygons, ordered by their relative poses:
+// by their attitudes, q and -q swapped the roles, 0.59 apart; a hostile review).
+TEST(OptimalSet, BoxEdgeOnATableWithinTheToleranceTiltedAFewPicoradians) {
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> normal;
+  const auto moved_by = [](const Eigen::Quaterniond& m, const Eigen::Vector3d& t,
+                           const Pose& pose) {
+    const Eigen::Quaterniond q =
+        m * Eigen::Quaterniond(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
+    return Pose(m * pose.r() + t, Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()));
+  };
+  for (const double radius : {0.0, 1.0, 1e3}) {
+    for (const double half_height : {0.5, 1.0}) {
+      for (const auto& [gap, tilt] : {std::pair{1e-12, 1.2e-12}, std::pair{1e-12, 5e-12},
+                                      std::pair{5e-13, 1e-11}, std::pair{2e-12, 3e-12}}) {
+        SCOPED_TRACE(::testing::Message()
+                     << "radius " << radius << ", box " << half_height << ", tilt " << tilt);
+        const PaddedPolygon table = square(1.0, radius);
+        const PaddedPolygon box = rectangle(1.0, half_height, radius);
+        const Eigen::Quaterniond upright(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()) *
+                                         Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()));
+        const Pose standing({0, 0, half_height + gap},
+                            Eigen::Vector4d(upright.w(), upright.x(), upright.y(), upright.z()));
+        const ProximityJacobian r = proximity_jacobian(table, Pose(), box, standing);
+        const ProximityJacobian swapped = proximity_jacobian(box, standing, table, Pose());
+        ASSERT_TRUE(r.cores_intersect && swapped.cores_intersect);
+        EXPECT_LE((swapped.core_points[0] - r.core_points[1]).norm(), 1e-13);
+        EXPECT_LE((swapped.core_points[1] - r.core_points[0]).norm(), 1e-13);
+        EXPECT_LE((swap_halves(swapped.gradient) - r.gradient).norm(), 1e-13 * (1 + radius));
+        // On the table, and on the edge's line within the tolerance (the crossing: |x| <= 1).
+        EXPECT_LE(std::abs(r.core_points[0].z()), 1e-11);
+        EXPECT_LE(std::abs(r.core_points[0].x()), 1.0 + 1e-11);
+        const Pose negated(Eigen::Vector3d::Zero(), -kIdentity);
+        EXPECT_LE(
+            (proximity(table, negated, box, standing).core_points[0] - r.core_points[0]).norm(),
+            1e-13);
+        for (int i = 0; i < 10; ++i) {
+          const Eigen::Quaterniond m =
+              Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+          const Eigen::Vector3d t(normal(rng), normal(rng), normal(rng));
+          const Pose table_pose = moved_by(m, t, Pose()), box_pose = moved_by(m, t, standing);
+          const Proximity after = i % 2 == 0 ? proximity(table, table_pose, box, box_pose)
+                                             : proximity(box, box_pose, table, table_pose);
+          const Eigen::Vector3d on_table = after.core_points[i % 2];
+          EXPECT_LE((on_table - (m * r.core_points[0] + t)).norm(), 1e-14 / tilt);
+        }
+      }
+    }
+  }
+}
+
 // A square's edge x = 0.5 beside a vertical square in the plane x = 1 (y in [-0.3, 0.7]): the
 // edge's part facing the other's face, y in [-0.3, 0.5].
 TEST(OptimalSet, EdgeFacingAFace) {

@@ -41,6 +41,15 @@
 //     Shapes far apart compared to their size (a distance V, sizes h) have their closest points
 //     to within the scene's rounding only: beyond V ~ 1e6 h neighbouring candidates' distances
 //     differ by less than the tie tolerance.
+//   - Two polygons are solved with the same one in the role of the first in both orders of the
+//     arguments (chosen by the polygons' own data, the one with more vertices first, and for
+//     identical polygons by their relative poses), so that swapping them swaps the points and
+//     permutes the gradient to rounding even where the tolerances decide the answer: a box's
+//     edge resting on a table within the tolerance and tilted a few 1e-12 rad, whose planes
+//     cross on a line that the edge's heights over the tilt place anywhere along it. A rigid
+//     motion and the sign of a quaternion keep the roles; a rigid motion moves such a crossing
+//     by the rounding of the heights over the tilt (~1e-16 of the size / tilt), the problem's
+//     own conditioning.
 //   - Nearly parallel features that are not parallel by that test (a sine just above 1e-12)
 //     have unique closest points and exact derivatives, computed from cross products of the
 //     features' directions (src/proximity/point_motion.cpp), but the problem is ill-conditioned

@@ -16,11 +16,14 @@ inline Eigen::Vector4d about(double angle, double x, double y, double z) {
           std::sin(angle / 2) * z};
 }
 
-// The square [-half, half]^2 with padding `radius`.
-inline PaddedPolygon square(double half, double radius) {
+// The rectangle [-half_x, half_x] x [-half_y, half_y] with padding `radius`.
+inline PaddedPolygon rectangle(double half_x, double half_y, double radius) {
   Eigen::MatrixX2d C(4, 2);
   C << 1, 0, 0, 1, -1, 0, 0, -1;
-  return PaddedPolygon(C, Eigen::VectorXd::Constant(4, half), radius);
+  return PaddedPolygon(C, Eigen::Vector4d(half_x, half_y, half_x, half_y), radius);
 }
+
+// The square [-half, half]^2 with padding `radius`.
+inline PaddedPolygon square(double half, double radius) { return rectangle(half, half, radius); }
 
 }  // namespace diffpills::testing
