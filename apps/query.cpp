@@ -22,7 +22,7 @@ bool flag(const json& query, const char* key) {
   return query[key].get<bool>();
 }
 
-nlohmann::ordered_json answer(const json& query) {
+nlohmann::ordered_json answer_valid_query(const json& query) {
   if (!query.is_object()) {
     throw std::invalid_argument("query: must be " + kQueryLine);
   }
@@ -80,6 +80,20 @@ nlohmann::ordered_json answer(const json& query) {
     }
   }
   return std::move(out);
+}
+
+// A query line's answer. The interior-point method's failures (SolverError: its iteration cap, or
+// a point outside a spike sharper than its tolerance) are answered as errors of the field that
+// chose it.
+nlohmann::ordered_json answer(const json& query) {
+  try {
+    return answer_valid_query(query);
+  } catch (const SolverError& failure) {
+    std::string reason = failure.what();
+    const std::string prefix = "diffpills: ";
+    if (reason.compare(0, prefix.size(), prefix) == 0) reason.erase(0, prefix.size());
+    throw std::runtime_error("method: \"interior_point\" failed: " + reason);
+  }
 }
 
 }  // namespace

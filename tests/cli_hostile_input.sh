@@ -67,6 +67,17 @@ printf '{"a": %s, "b": %s, "shape_gradient": true}\n{"a": %s, "b": %s}\n' \
 check_answers "$work/out" er
 grep -q '"error":"shape_gradient: a' "$work/out" || fail "an infinite shape gradient: no error"
 
+# The interior-point method's failure is an error naming "method" (a hostile review: it named no
+# field): fuzz_proximity's needle, whose apex is sharper than the method's tolerance
+# (test_degenerate.cpp, NeedleWhoseApexIsBelowTheRounding). The default method answers it.
+needle='{"type": "polygon", "C": [[-0.20260703884442144,-0.97926012264908202],[0.20260703884442111,0.97926012264908202],[-0.47679923006332192,0.87901222642863353],[-0.11479492660650993,-0.99338921114808065]], "d": [6.1363668316221582e-92,6.1363668316221582e-92,1e-300,0.125], "radius": 0, "r": [2,1.25,1.25], "q": [-0.5,0.5,-0.5,0.5]}'
+stick='{"type": "capsule", "length": 2.875, "radius": 2.875, "r": [1.25,1.25,-0.75], "q": [1,0,0,0]}'
+printf '{"a": %s, "b": %s, "method": "interior_point"}\n{"a": %s, "b": %s}\n' \
+  "$needle" "$stick" "$needle" "$stick" | "$bin" query > "$work/out"
+check_answers "$work/out" er
+grep -q '"error":"method: \\"interior_point\\" failed: ' "$work/out" ||
+  fail "the interior-point method's failure: no error naming method"
+
 # Memory running out is an answer too, each such line followed by a valid query: a line of 4
 # million numbers under a 100 MB limit of address space (parsed, it needs ~2 GB), and a 60 MB line
 # under 50 MB (too long to keep). A hostile review: the parsed line's destructor allocated and
