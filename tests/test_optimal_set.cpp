@@ -288,6 +288,29 @@ TEST(OptimalSet, StackedSquares) {
                 {0.425, 0.375, 0}, {0.425, 0.375, 0.3});
 }
 
+// Identical regular 51-gons stacked face to face, one turned a half turn about z less a few
+// 1e-12 rad, the other a half turn about y: each row of one lies a few 1e-12 rad from a row of
+// the other, and the overlap of their shadows is the whole polygon, whose centroid is its centre.
+// The overlap's corners were met by Cramer's rule, which divided rounding in every direction by
+// that angle: the corners left their lines by 2e-5 and the centroid moved by 8e-7, mirrored in
+// the two orders of the shapes (fuzz_proximity, at a scale of 1e70). Apart (0.5 above) and with
+// the cores within the tolerance (1e-13 above).
+TEST(OptimalSet, IdenticalPolygonsAHalfTurnApartFaceToFace) {
+  const int sides = 51;
+  Eigen::MatrixX2d C(sides, 2);
+  for (int k = 0; k < sides; ++k) {
+    C.row(k) << std::cos(2 * M_PI * k / sides), std::sin(2 * M_PI * k / sides);
+  }
+  const PaddedPolygon polygon(C, Eigen::VectorXd::Ones(sides), 1.0);
+  for (const double turn : {3e-12, 6e-12, 1e-11}) {
+    for (const double height : {0.5, 1e-13}) {
+      SCOPED_TRACE(::testing::Message() << "turn " << turn << ", height " << height);
+      expect_middle(polygon, Pose(Eigen::Vector3d::Zero(), about(M_PI - turn, 0, 0, 1)), polygon,
+                    Pose({0, 0, height}, about(M_PI, 0, 1, 0)), {0, 0, 0}, {0, 0, height});
+    }
+  }
+}
+
 // Stacked regular octagons whose rows of one direction straddle the angle 0, the second turned by
 // -1e-158 rad (a row normal (1, -1e-158) sorts just below 2 pi, its twin (1, 0) at 0): the overlap
 // of their shadows is the whole octagon, not empty (fuzz_proximity found the overlap empty in
