@@ -11,7 +11,8 @@
 //   - only documented exceptions: std::invalid_argument from construction (bad sizes, unbounded
 //     polygons, zero or non-finite quaternions), SolverError from the interior-point method;
 //   - finite phi, points, gradient and Jacobians; a unit normal; phi >= -(R1 + R2)^2;
-//   - swap symmetry: proximity(b, a) has the same phi and the points swapped;
+//   - swap symmetry: proximity(b, a) has the same phi and the points swapped (two polygons: to
+//     1e-10 of the scene and the body origins' magnitudes, ties and tolerance-decided cases too);
 //   - the interior-point reference agrees with the default path on phi (one pair in four);
 //   - proximity_batch over a few rows and threads equals the single calls bit for bit (two
 //     capsules: to 1e-12 of the scene, the vector kernel, with signed_distance_batch too);
@@ -457,6 +458,19 @@ void check_queries(FuzzedDataProvider& data, const Shape& a, const Pose& pose_a,
   check_result(ba, radii);
   const double phi_tolerance = 1e-12 * scene * scene;
   check(std::abs(ab.phi - ba.phi) <= phi_tolerance, "swap symmetry of phi", ab.phi - ba.phi);
+  // Two polygons are solved with the same one first in both orders (pair_setup.hpp,
+  // solve_b_as_a), so their closest points swap to the rounding of the results even where ties
+  // or the tolerances decide them (the issue asks for 1e-9 of the scene; the reviews measure
+  // 1e-13). The results round in coordinates as large as the body origins.
+  if (std::holds_alternative<PaddedPolygon>(a) && std::holds_alternative<PaddedPolygon>(b)) {
+    const double reach = scene + std::max(pose_a.r().lpNorm<Eigen::Infinity>(),
+                                          pose_b.r().lpNorm<Eigen::Infinity>());
+    const double apart =
+        std::max((ab.core_points[0] - ba.core_points[1]).lpNorm<Eigen::Infinity>(),
+                 (ab.core_points[1] - ba.core_points[0]).lpNorm<Eigen::Infinity>());
+    check(apart <= 1e-10 * reach + 8 * std::numeric_limits<double>::denorm_min(),
+          "two polygons: both orders give the same closest points", apart / reach);
+  }
 
   check_signed_distance(a, pose_a, b, pose_b, ab, radii, scene);
 
