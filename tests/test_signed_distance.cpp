@@ -487,7 +487,10 @@ TEST(SignedDistance, CapsuleInThePlaneOfAPolygon) {
   EXPECT_TRUE(sd.gradient.allFinite() && sd.points_jacobian.allFinite());
 }
 
-// Stacked, coplanar squares (flat D): s = 0, the witnesses in the middle of the overlap.
+// Stacked, coplanar squares (flat D): s = 0, the witnesses in the middle of the overlap. The
+// normal is +-z alike; both orders must pick the same one, reversed (a hostile review: the first
+// argument's face normal in both orders, the padded points 2R apart and the gradients of opposite
+// sign), for the same square twice and for a rectangle turned against it.
 TEST(SignedDistance, CoplanarOverlappingSquares) {
   const PaddedPolygon a = square(1.0, 0.1), b = square(1.0, 0.1);
   const SignedDistance sd = signed_distance(a, Pose(Eigen::Vector3d::Zero(), kIdentity), b,
@@ -495,6 +498,23 @@ TEST(SignedDistance, CoplanarOverlappingSquares) {
   EXPECT_NEAR(sd.distance, -0.2, 1e-15);
   EXPECT_NEAR(std::abs(sd.normal.z()), 1.0, 1e-15);
   EXPECT_NEAR((sd.core_points[0] - Eigen::Vector3d(0.5, 0, 0)).norm(), 0.0, 1e-14);
+
+  const PaddedPolygon rectangle_b = rectangle(0.5, 0.8, 0.1);
+  const Pose turned({0.3, 0.2, 0}, about(0.4, 0, 0, 1));
+  for (const PaddedPolygon* other : {&b, &rectangle_b}) {
+    const SignedDistanceJacobian ab = signed_distance_jacobian(a, Pose(), *other, turned);
+    const SignedDistanceJacobian ba = signed_distance_jacobian(*other, turned, a, Pose());
+    EXPECT_EQ(ab.distance, ba.distance);
+    EXPECT_LE((ab.normal + ba.normal).norm(), 1e-15);
+    EXPECT_LE((ab.points[0] - ba.points[1]).norm(), 1e-15);
+    EXPECT_LE((ab.points[1] - ba.points[0]).norm(), 1e-15);
+    EXPECT_LE((ab.gradient.head<7>() - ba.gradient.tail<7>()).norm(), 1e-14);
+    EXPECT_LE((ab.gradient.tail<7>() - ba.gradient.head<7>()).norm(), 1e-14);
+    // Rows [p1; p2] and columns [r1 q1 r2 q2], both swapped.
+    const Eigen::Matrix<double, 3, 7> da_in_ab = ab.points_jacobian.block<3, 7>(0, 0);
+    const Eigen::Matrix<double, 3, 7> da_in_ba = ba.points_jacobian.block<3, 7>(3, 7);
+    EXPECT_LE((da_in_ab - da_in_ba).norm(), 1e-13);
+  }
 }
 
 // Two equal hexagons crossing at 2e-11 rad about a line through their centres: D is a thin

@@ -37,7 +37,9 @@
 //   - D flat (two segments, a segment lying in a polygon's plane, coplanar polygons) and holding
 //     0: s = 0, distance = -(R1 + R2). Its two normals +-n (n normal to D's plane) tie, and the
 //     one pointing from shape 1's body origin to shape 2's is taken (n . (r2 - r1) > 0), or if
-//     they are level, the one along shape 1's body z axis. For parallel segments (or spheres)
+//     they are level, the one along shape 1's body z axis. Two polygons are solved with the same
+//     one as shape 1 in both orders of the arguments (as by proximity(), proximity.hpp), so that
+//     swapping them reverses the normal. For parallel segments (or spheres)
 //     whose D is a segment or a point, the normal is the part of r2 - r1 normal to the segments,
 //     or if that vanishes shape 1's (or else shape 2's) body z axis made normal to them; its
 //     derivative is taken as zero there.

@@ -114,8 +114,19 @@ inline bool solve_b_as_a(const PaddedPolygon& a, const PosedCore& pa, const Padd
   return identical_b_first(pa, pb);
 }
 
-// Two polygons, solved with A the first of the two (solve_b_as_a): with B as A, B's origin is the
-// frame's and A's lies at minus B's offset, exactly the frame of the other order of the arguments.
+// The cores posed for solving B first: B's origin where A's is and A's at minus B's offset from
+// it, exactly the frame of the other order of the arguments (x - y = -(y - x) in floating point).
+struct SwappedCores {
+  PosedCore first, second;  // B, then A
+};
+inline SwappedCores b_first(const PosedCore& pa, const PosedCore& pb) {
+  SwappedCores out{pb, pa};
+  out.first.r = pa.r;
+  out.second.r = pa.r - (pb.r - pa.r);
+  return out;
+}
+
+// Two polygons, solved with A the first of the two (solve_b_as_a).
 inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const PaddedPolygon& b,
                         const PosedCore& pb, const PairFrame& frame) {
   const CoreTolerances tolerances = search_tolerances(pa, pb, frame);
@@ -124,11 +135,10 @@ inline Sides fast_sides(const PaddedPolygon& a, const PosedCore& pa, const Padde
     return detail::solve_polygon_polygon(view_a, pa, view_b, pb, tolerances.intersection,
                                          tolerances.tie);
   }
-  PosedCore b_first = pb, a_second = pa;
-  b_first.r = pa.r;
-  a_second.r = pa.r - (pb.r - pa.r);
-  const Sides swapped = detail::solve_polygon_polygon(view_b, b_first, view_a, a_second,
-                                                      tolerances.intersection, tolerances.tie);
+  const SwappedCores swapped_cores = b_first(pa, pb);
+  const Sides swapped =
+      detail::solve_polygon_polygon(view_b, swapped_cores.first, view_a, swapped_cores.second,
+                                    tolerances.intersection, tolerances.tie);
   return {swapped[1], swapped[0]};
 }
 

@@ -86,8 +86,8 @@ std::optional<PolygonView> polygon_view(const PaddedPolygon& polygon, const Pair
 }
 
 template <class ShapeA, class ShapeB>
-SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, const PosedCore& pb,
-                     const PairFrame& frame) {
+SignedSolution solve_in_order(const ShapeA& a, const PosedCore& pa, const ShapeB& b,
+                              const PosedCore& pb, const PairFrame& frame) {
   SignedSolution solution;
   solution.sides = detail::fast_sides(a, pa, b, pb, frame);
   const Eigen::Vector3d x1 = pa.r + pa.attitude.matrix() * solution.sides[0].body_point;
@@ -129,6 +129,36 @@ SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, cons
   // Touching, or a flat D, leave the closest points as they are (the middle of the cores'
   // intersection), as does the search's fallback (penetration.hpp).
   if (facet.witnesses) solution.sides = *facet.witnesses;
+  return solution;
+}
+
+template <class ShapeA, class ShapeB>
+SignedSolution solve(const ShapeA& a, const PosedCore& pa, const ShapeB& b, const PosedCore& pb,
+                     const PairFrame& frame) {
+  return solve_in_order(a, pa, b, pb, frame);
+}
+
+// Two polygons are solved in solve_b_as_a's order (pair_setup.hpp), as their proximity is, so
+// that both orders of the arguments get the same answer where the search's choice is free (the
+// normal of coplanar overlapping polygons, +-z alike, was the first argument's face normal in
+// both orders: a hostile review). The solution is then turned back: the sides swapped, the
+// normal, from the first argument's core to the second's, negated, and its source with it. A
+// face normal sign * Q_face e_z becomes -sign * Q_face e_z of the same core, and an edge pair's
+// sign * unit(e x f) is sign * unit(f x e) of the swapped edges.
+SignedSolution solve(const PaddedPolygon& a, const PosedCore& pa, const PaddedPolygon& b,
+                     const PosedCore& pb, const PairFrame& frame) {
+  if (!detail::solve_b_as_a(a, pa, b, pb)) return solve_in_order(a, pa, b, pb, frame);
+  const detail::SwappedCores cores = detail::b_first(pa, pb);
+  SignedSolution solution = solve_in_order(b, cores.first, a, cores.second, frame);
+  std::swap(solution.sides[0], solution.sides[1]);
+  solution.normal = -solution.normal;
+  NormalSource& source = solution.source;
+  if (source.kind == NormalSource::Kind::kFace) {
+    source.face_core = 1 - source.face_core;
+    source.sign = -source.sign;
+  } else if (source.kind == NormalSource::Kind::kEdges) {
+    std::swap(source.edge_directions[0], source.edge_directions[1]);
+  }
   return solution;
 }
 
