@@ -307,13 +307,19 @@ bool finite(const diffpills::ShapeGradient& gradient) {
   return polygon == nullptr || (polygon->C.allFinite() && polygon->d.allFinite());
 }
 
-// The polygon with every row rescaled by an exact power of two 2^exponents(i) to a length in
-// [1/2, 1): the same half-planes, so the same polygon.
-PaddedPolygon with_unit_rows(const PaddedPolygon& polygon, Eigen::VectorXi& exponents) {
+// The polygon with each row whose gradient is not finite rescaled by an exact power of two
+// 2^exponents(i) to a length in [1/2, 1): the same half-planes, so the same polygon. Only those
+// rows: they are active (a nonzero multiplier), so their lines pass by the polygon and d_i / |C_i|
+// is within its extent, while a loose row of a short C_i would be rescaled past the accepted
+// magnitudes (fuzz_proximity: d = 1e100 with |C_i| = 6e-83).
+PaddedPolygon with_unit_rows(const PaddedPolygon& polygon,
+                             const diffpills::PolygonShapeGradient& gradient,
+                             Eigen::VectorXi& exponents) {
   Eigen::MatrixX2d C = polygon.constraint_matrix();
   Eigen::VectorXd d = polygon.constraint_offsets();
-  exponents.resize(C.rows());
+  exponents = Eigen::VectorXi::Zero(C.rows());
   for (Eigen::Index i = 0; i < C.rows(); ++i) {
+    if (gradient.C.row(i).allFinite() && std::isfinite(gradient.d(i))) continue;
     int length_exponent = 0;
     std::frexp(std::hypot(C(i, 0), C(i, 1)), &length_exponent);
     exponents(i) = -length_exponent;
@@ -340,8 +346,8 @@ bool scales_back(double given, double unit, int exponent) {
 
 // Shape gradients (shape_gradient.hpp): well formed, and finite except in polygon rows whose
 // 1 / |C_i| carries them beyond the double range, where they are +-infinity (the command answers
-// those with an error). An infinite entry is confirmed by asking again with that polygon's rows
-// rescaled to unit length: the same answer, finite, that scales back to the infinity.
+// those with an error). An infinite entry is confirmed by asking again with those rows of that
+// polygon rescaled to unit length: the same answer, finite, that scales back to the infinity.
 template <typename Answer, typename Ask>
 void check_shape_gradients(const Answer& answer, const Shape& a, const Shape& b, const Ask& ask,
                            const char* what) {
@@ -352,7 +358,8 @@ void check_shape_gradients(const Answer& answer, const Shape& a, const Shape& b,
     if (finite(gradient)) continue;
     Eigen::VectorXi exponents;
     const PaddedPolygon unit_rows =
-        with_unit_rows(std::get<PaddedPolygon>(*shapes[side]), exponents);
+        with_unit_rows(std::get<PaddedPolygon>(*shapes[side]),
+                       std::get<diffpills::PolygonShapeGradient>(gradient), exponents);
     const Answer again = side == 0 ? ask(unit_rows, b) : ask(a, unit_rows);
     check(again.points == answer.points, "rows rescaled to unit length: the same points");
     const auto& given = std::get<diffpills::PolygonShapeGradient>(gradient);
