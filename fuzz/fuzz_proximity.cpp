@@ -16,7 +16,8 @@
 //   - the interior-point reference agrees with the default path on phi (one pair in four);
 //   - proximity_batch over a few rows and threads equals the single calls bit for bit (two
 //     capsules: to 1e-12 of the scene, the vector kernel, with signed_distance_batch too);
-//   - the signed distance: finite, a unit normal, swap symmetry, points[1] - points[0] =
+//   - the signed distance: finite, a unit normal, swap symmetry (two polygons: the witnesses
+//     swapped and the normals opposite, to 1e-10 and rounding), points[1] - points[0] =
 //     distance * normal with the witnesses on the cores, and agreement with proximity()'s
 //     closest points where the cores are apart (distance + R1 + R2 = |p1 - p2|) or at most
 //     -(R1 + R2) where they intersect;
@@ -267,6 +268,32 @@ void check_signed_distance(const Shape& a, const Pose& pose_a, const Shape& b, c
                 proximity.core_points[1].lpNorm<Eigen::Infinity>()});
   check(std::abs(ab.distance - ba.distance) <= tolerance, "swap symmetry of the signed distance",
         ab.distance - ba.distance);
+  // Two polygons are solved with the same one first in both orders (signed_distance.cpp), so
+  // their witnesses swap and their normals are opposite, where the cores' normal is free (coplanar
+  // polygons) too. Not for two identical polygons: where their relative pose is its own inverse
+  // (a half turn), the rigid motion that carries each onto the other turns one order of the
+  // arguments into the other, and penetration facets that tie (symmetric under it) are decided
+  // by a rule that no choice can make both swap-symmetric and rigid-motion invariant.
+  const auto* polygon_a = std::get_if<PaddedPolygon>(&a);
+  const auto* polygon_b = std::get_if<PaddedPolygon>(&b);
+  if (polygon_a != nullptr && polygon_b != nullptr &&
+      (polygon_a->vertices().rows() != polygon_b->vertices().rows() ||
+       polygon_a->vertices() != polygon_b->vertices() ||
+       polygon_a->radius() != polygon_b->radius())) {
+    const double reach = scene + std::max(pose_a.r().lpNorm<Eigen::Infinity>(),
+                                          pose_b.r().lpNorm<Eigen::Infinity>());
+    const double apart =
+        std::max((ab.core_points[0] - ba.core_points[1]).lpNorm<Eigen::Infinity>(),
+                 (ab.core_points[1] - ba.core_points[0]).lpNorm<Eigen::Infinity>());
+    check(apart <= 1e-10 * reach + 8 * std::numeric_limits<double>::denorm_min(),
+          "two polygons: both orders give the same witnesses", apart / reach);
+    // A normal taken from the points turns by their rounding over the gap (cores just apart).
+    const double gap = std::abs(ab.distance + radii);
+    check((ab.normal + ba.normal).lpNorm<Eigen::Infinity>() <=
+              1e-10 + 1e3 * std::numeric_limits<double>::epsilon() * reach / gap,
+          "two polygons: both orders give opposite normals",
+          (ab.normal + ba.normal).lpNorm<Eigen::Infinity>());
+  }
 
   check((ab.points[1] - ab.points[0] - ab.distance * ab.normal).stableNorm() <=
             tolerance + representable,
