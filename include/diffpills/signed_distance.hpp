@@ -39,10 +39,11 @@
 //     one pointing from shape 1's body origin to shape 2's is taken (n . (r2 - r1) > 0), or if
 //     they are level, the one along shape 1's body z axis. Two polygons are solved with the same
 //     one as shape 1 in both orders of the arguments (as by proximity(), proximity.hpp), so that
-//     swapping them reverses the normal. For parallel segments (or spheres)
-//     whose D is a segment or a point, the normal is the part of r2 - r1 normal to the segments,
-//     or if that vanishes shape 1's (or else shape 2's) body z axis made normal to them; its
-//     derivative is taken as zero there.
+//     swapping them reverses the normal; not two identical polygons a half turn apart, whose
+//     orders a rigid motion exchanges, so that no choice is preferred. For parallel segments (or
+//     spheres) whose D is a segment or a point, the normal is the part of r2 - r1 normal to the
+//     segments, or if that vanishes shape 1's (or else shape 2's) body z axis made normal to
+//     them; its derivative is taken as zero there.
 //   - Penetrating facets that tie (a capsule through a polygon's centre, equally deep both ways)
 //     are decided by the same rule; the normal then jumps as the configuration leaves the tie,
 //     and the gradient is that of the chosen facet (one-sided).
