@@ -49,10 +49,8 @@
 //     cross on a line that the edge's heights over the tilt place anywhere along it. A rigid
 //     motion and the sign of a quaternion keep the roles; a rigid motion moves such a crossing
 //     by the rounding of the heights over the tilt (~1e-16 of the size / tilt), the problem's
-//     own conditioning. Not yet where two identical polygons' relative pose is its own inverse
-//     (turned a half turn against each other): no order of the two is then preferred, both
-//     roles pose the same problem, and the orders agree only as closely as the parallel
-//     overlap's centre is computed (2e-6 of the scene found by fuzz_proximity).
+//     own conditioning. (Two identical polygons whose relative pose is its own inverse, a half
+//     turn, prefer no order: both roles pose the same problem, whose middle is the same point.)
 //   - Nearly parallel features that are not parallel by that test (a sine just above 1e-12)
 //     have unique closest points and exact derivatives, computed from cross products of the
 //     features' directions (src/proximity/point_motion.cpp), but the problem is ill-conditioned
