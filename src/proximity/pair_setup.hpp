@@ -73,18 +73,29 @@ int lexicographic_order(const Eigen::DenseBase<Derived>& x, const Eigen::DenseBa
 // motion of the scene and the sign of a quaternion leave unchanged: w . t for the other's origin
 // t in each one's frame, then w . (R u) for a body direction u carried by the other's rotation in
 // each one's frame, with weights w of irrational ratios so that no axis-aligned scene ties. Both
-// are computed by the same operations in either order of the arguments, so the decision is exactly
-// antisymmetric. Where both tie (the same origin and attitude, or a relative pose that is its own
-// inverse), the two roles pose the same problem.
+// are computed by the same operations in either order of the arguments, so each comparison is
+// exactly antisymmetric. Where w . t ties exactly (t level with w's plane in both frames, which a
+// chosen translation such as (2^(-1/2), -1/2, 0) at equal attitudes makes it: a hostile review),
+// the offsets themselves decide, in lexicographic order, and likewise the carried directions.
+// Where all tie (the same origin and attitude, or a relative pose that is its own inverse), the
+// two roles pose the same problem.
 inline bool identical_b_first(const PosedCore& pa, const PosedCore& pb) {
   const Eigen::Vector3d w(1.0, 1.4142135623730951, 1.7320508075688772);  // 1, 2^(1/2), 3^(1/2)
   const Eigen::Matrix3d& Ra = pa.attitude.matrix();
   const Eigen::Matrix3d& Rb = pb.attitude.matrix();
-  const double b_seen_from_a = w.dot(Ra.transpose() * (pb.r - pa.r));
-  const double a_seen_from_b = w.dot(Rb.transpose() * (pa.r - pb.r));
-  if (b_seen_from_a != a_seen_from_b) return b_seen_from_a > a_seen_from_b;
+  const Eigen::Vector3d b_seen_from_a = Ra.transpose() * (pb.r - pa.r);
+  const Eigen::Vector3d a_seen_from_b = Rb.transpose() * (pa.r - pb.r);
+  if (w.dot(b_seen_from_a) != w.dot(a_seen_from_b)) {
+    return w.dot(b_seen_from_a) > w.dot(a_seen_from_b);
+  }
+  if (const int order = lexicographic_order(b_seen_from_a, a_seen_from_b)) return order > 0;
   const Eigen::Vector3d u(1.0, 1.4142135623730951, 0.0);
-  return w.dot(Ra.transpose() * (Rb * u)) > w.dot(Rb.transpose() * (Ra * u));
+  const Eigen::Vector3d b_turned_from_a = Ra.transpose() * (Rb * u);
+  const Eigen::Vector3d a_turned_from_b = Rb.transpose() * (Ra * u);
+  if (w.dot(b_turned_from_a) != w.dot(a_turned_from_b)) {
+    return w.dot(b_turned_from_a) > w.dot(a_turned_from_b);
+  }
+  return lexicographic_order(b_turned_from_a, a_turned_from_b) > 0;
 }
 
 // Which of two polygons is solved as A, in whose body frame everything happens
