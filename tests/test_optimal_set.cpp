@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "diffpills/diffpills.hpp"
+#include "support/random_shapes.hpp"
 #include "support/scene_helpers.hpp"
 
 namespace diffpills::testing {
@@ -221,12 +222,6 @@ TEST(OptimalSet, BoxEdgeOnATable) {
 TEST(OptimalSet, BoxEdgeOnATableWithinTheToleranceTiltedAFewPicoradians) {
   std::mt19937_64 rng(12);
   std::normal_distribution<double> normal;
-  const auto moved_by = [](const Eigen::Quaterniond& m, const Eigen::Vector3d& t,
-                           const Pose& pose) {
-    const Eigen::Quaterniond q =
-        m * Eigen::Quaterniond(pose.q()(0), pose.q()(1), pose.q()(2), pose.q()(3));
-    return Pose(m * pose.r() + t, Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()));
-  };
   for (const double radius : {0.0, 1.0, 1e3}) {
     for (const double half_height : {0.5, 1.0}) {
       for (const auto& [gap, tilt] : {std::pair{1e-12, 1.2e-12}, std::pair{1e-12, 5e-12},
@@ -256,7 +251,8 @@ TEST(OptimalSet, BoxEdgeOnATableWithinTheToleranceTiltedAFewPicoradians) {
           const Eigen::Quaterniond m =
               Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
           const Eigen::Vector3d t(normal(rng), normal(rng), normal(rng));
-          const Pose table_pose = moved_by(m, t, Pose()), box_pose = moved_by(m, t, standing);
+          const Pose table_pose = rigidly_moved(Pose(), m, t);
+          const Pose box_pose = rigidly_moved(standing, m, t);
           const Proximity after = i % 2 == 0 ? proximity(table, table_pose, box, box_pose)
                                              : proximity(box, box_pose, table, table_pose);
           const Eigen::Vector3d on_table = after.core_points[i % 2];
