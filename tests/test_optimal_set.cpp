@@ -321,5 +321,32 @@ TEST(OptimalSet, StackedPolygonsWithRowsAcrossAngleZero) {
   }
 }
 
+// Faces level to rounding, far apart (issue 9): identical polygons 1e8 apart, the upper one tilted
+// 1e-8 rad about x, so that their heights over each other vary by ~2e-8, below the rounding of
+// coordinates 1e8 from the origin (64 ulps, 1.4e-6), and every pair of their features ties. They
+// are solved as parallel faces across their mean normal m, 5e-9 rad from z towards -y: the pair is
+// the centre of the overlap of their shadows along m, p1 = (0, s, 0) with s = D tan(tilt / 2) / 2,
+// and p2 = p1 mirrored through (0, 0, D / 2). Squares (the enumeration) and 2,000-gons (the
+// windows); and squares side by side, their shadows apart: the middle of the overlap of their
+// facing edges' shadows, which the mean normal offsets by 2 s. Before, every feature pair was swept
+// (1.3 s for two 8,000-gons) and a pair that rounding chose came back.
+TEST(OptimalSet, LevelFacesFarApart) {
+  const double distance = 1e8, tilt = 1e-8, s = 0.5 * distance * std::tan(0.5 * tilt);
+  const Eigen::Vector4d tilted = about(tilt, 1, 0, 0);
+  const int sides = 2000;
+  Eigen::MatrixX2d C(sides, 2);
+  for (int k = 0; k < sides; ++k) {
+    C.row(k) << std::cos(2 * M_PI * k / sides), std::sin(2 * M_PI * k / sides);
+  }
+  const PaddedPolygon many_sided(C, Eigen::VectorXd::Ones(sides), 0.0);
+  for (const PaddedPolygon& polygon : {square(1.0, 0.0), many_sided}) {
+    SCOPED_TRACE(::testing::Message() << polygon.edge_rows().size() << " sides");
+    expect_middle(polygon, Pose(), polygon, Pose({0, 0, distance}, tilted), {0, s, 0},
+                  {0, -s, distance}, distance);
+  }
+  expect_middle(square(1.0, 0.0), Pose(), square(1.0, 0.0), Pose({3, 0, distance}, tilted),
+                {1, s, 0}, {2, -s, distance}, distance);
+}
+
 }  // namespace
 }  // namespace diffpills::testing

@@ -40,7 +40,12 @@
 //     that of the cores' own, the larger core and the distance between the body origins.)
 //     Shapes far apart compared to their size (a distance V, sizes h) have their closest points
 //     to within the scene's rounding only: beyond V ~ 1e6 h neighbouring candidates' distances
-//     differ by less than the tie tolerance.
+//     differ by less than the tie tolerance. Two polygons apart whose heights over each other's
+//     planes vary by less than the rounding of their coordinates (64 ulps of V plus their sizes,
+//     and at most the tie tolerance: unit polygons 1e8 apart and up to ~5e-7 rad from parallel)
+//     are level faces: every pair of features ties, and they are solved as parallel faces across
+//     their mean normal, the centre of the overlap of their shadows along it (or the middle of the
+//     shadows' closest set), each polygon's point over it, the same in both orders.
 //   - Two polygons are solved with the same one in the role of the first in both orders of the
 //     arguments (chosen by the polygons' own data, the one with more vertices first, and for
 //     identical polygons by their relative poses), so that swapping them swaps the points and

@@ -16,6 +16,8 @@ namespace diffpills::detail {
 // Polygon B's placement in polygon A's body frame, and A's in B's.
 struct PolygonPairFrame {
   PolygonPairFrame(const PosedCore& a, const PosedCore& b);
+  // B's attitude (rotation) and body origin in A's frame given directly.
+  PolygonPairFrame(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& origin);
   Eigen::Matrix3d b_in_a;         // rotation from B's body frame to A's
   Eigen::Vector3d b_origin_in_a;  // B's body origin in A's frame
   Eigen::Vector3d a_origin_in_b;  // A's body origin in B's frame
@@ -53,9 +55,10 @@ class CarriedPolygon {
 // polygon_polygon.cpp): a support vertex of one over the other's face (or, for an edge parallel to
 // that face, the middle of its part over it), and every pair of edges (the middle of their overlap
 // when parallel), the pairs whose lower bound exceeds the best distance by the tie band skipped
-// (the larger of the tolerance and the tie tolerance; windows too large to visit every pair, the
-// tolerance), up to 32 x 32 vertex pairs with segment_bounds.hpp's vector bounds where the CPU has
-// 4 lanes. Candidates for a whole interval win ties within the tie tolerance (pair_frame.hpp).
+// (the tie tolerance; windows more than 1,000 times their extents apart, or specks, are swept by
+// depth with the band only for pairs that can make an interval), up to 32 x 32 vertex pairs with
+// segment_bounds.hpp's vector bounds where the CPU has 4 lanes. Candidates for a whole interval
+// win ties within the tie tolerance (pair_frame.hpp).
 std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const PolygonView& b,
                                                 const PolygonPairFrame& frame,
                                                 const CarriedPolygon<PolygonView>& W,
