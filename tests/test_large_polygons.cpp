@@ -397,6 +397,51 @@ TEST(LargePolygons, NeedleSignedDistancesThinnerThanTheTolerance) {
   EXPECT_GE(penetrating, 12);
 }
 
+// The same needles shrunk by 1e-95, 2e-106 long beside radii of 1: cores below 1e-100 of the
+// frame's units keep the frame's tolerances (pair_frame.hpp), 1e94 times their size, so the
+// penetration search took every depth as touching and returned the closest points, a gap of 0,
+// for cores 1e-109 deep, and met every facet (1.8 s at 8,000 vertices). The signed distance now
+// solves such cores in a frame of their own: the witnesses' gap along the normal is the brute
+// force's signed gap to 1e-12 of the needles' length, in both orders, with opposite normals.
+TEST(LargePolygons, NeedleSignedDistancesBelow1e100OfTheirRadii) {
+  Rng rng(62);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double shrink = 1e-95, length = shrink * kNeedleLength;
+  int penetrating = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    SCOPED_TRACE(::testing::Message() << "trial " << trial);
+    TestShape a = needle(36 + trial, 0.0, 1.0), b = needle(40 + 2 * trial, 0.3, 1.0);
+    for (TestShape* shape : {&a, &b}) {
+      const auto& polygon = std::get<PaddedPolygon>(shape->shape);
+      shape->shape =
+          PaddedPolygon(polygon.constraint_matrix(), shrink * polygon.constraint_offsets(), 1.0);
+      for (Eigen::Vector3d& vertex : shape->body_vertices) vertex *= shrink;
+      shape->size *= shrink;
+    }
+    const Eigen::Vector4d q(normal(rng), normal(rng), normal(rng), normal(rng));
+    const Pose pa(Eigen::Vector3d::Zero(), kIdentity);
+    const Pose pb(1e-3 * length * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)), q);
+    const WorldCore wa = to_world(a, pa), wb = to_world(b, pb);
+    const long double apart = brute_force_closest(wa, wb).distance;
+    const double gap =
+        static_cast<double>(apart > 0 ? apart : -brute_force_penetration_depth(wa, wb));
+    penetrating += apart > 0 ? 0 : 1;
+    const auto& padded_a = std::get<PaddedPolygon>(a.shape);
+    const auto& padded_b = std::get<PaddedPolygon>(b.shape);
+    const SignedDistance ab = signed_distance(padded_a, pa, padded_b, pb);
+    const SignedDistance ba = signed_distance(padded_b, pb, padded_a, pa);
+    const auto core_gap = [](const SignedDistance& s) {
+      return (s.core_points[1] - s.core_points[0]).dot(s.normal);
+    };
+    EXPECT_NEAR(core_gap(ab), gap, 1e-12 * length);
+    EXPECT_NEAR(core_gap(ba), gap, 1e-12 * length);
+    EXPECT_EQ(ab.penetrating, apart <= 0);
+    EXPECT_LE((ab.normal + ba.normal).norm(), 1e-12);
+    EXPECT_LE((ab.core_points[0] - ba.core_points[1]).norm(), 1e-12 * length);
+  }
+  EXPECT_GE(penetrating, 12);
+}
+
 // Cores from 5e-10 to 1e-6 of the radii that make the scene (a hostile review: discs just above
 // the 1e-9 below which a pair counted as specks took 0.8-1.3 s at 10^5 vertices, 1,000x the same
 // cores with radius 0, with ~1,400 vertices of each within the scene's tolerance of a support), and
