@@ -301,15 +301,20 @@ void large_polygon_sizes(benchmark::internal::Benchmark* benchmark) {
       ->Unit(benchmark::kMillisecond);
 }
 
+// Two unit-circumradius k-gons, radius 0, the first at the origin and the second at `second`.
+void run_unit_polygons(benchmark::State& state, const Pose& second) {
+  const auto count = static_cast<int>(state.range(0));
+  const PaddedPolygon polygon = regular_polygon(count, 1.0, 0.0);
+  const Pose origin;
+  for (auto _ : state) benchmark::DoNotOptimize(proximity(polygon, origin, polygon, second));
+  state.SetComplexityN(count);
+}
+
 // Nearly parallel faces (a hostile review's stall): two unit-circumradius k-gons, one 0.5 above
 // the other and tilted 1e-11 rad about x, so that thousands of vertices of each tie within the
 // windows' margin and the windows' pairs are swept (separated_polygons.cpp).
 void PolygonPolygon_NearlyParallel(benchmark::State& state) {
-  const auto count = static_cast<int>(state.range(0));
-  const PaddedPolygon polygon = regular_polygon(count, 1.0, 0.0);
-  const Pose below, above({0, 0, 0.5}, {std::cos(0.5e-11), std::sin(0.5e-11), 0, 0});
-  for (auto _ : state) benchmark::DoNotOptimize(proximity(polygon, below, polygon, above));
-  state.SetComplexityN(count);
+  run_unit_polygons(state, Pose({0, 0, 0.5}, {std::cos(0.5e-11), std::sin(0.5e-11), 0, 0}));
 }
 BENCHMARK(PolygonPolygon_NearlyParallel)->Apply(large_polygon_sizes);
 
@@ -337,11 +342,7 @@ BENCHMARK(PolygonPolygon_FarApart)->Apply(large_polygon_sizes);
 // distance, and the windows judge ties by that tie tolerance, not by the intersection tolerance
 // (1e-12 of the distance, 1e-4 here, which took the polygons whole; polygon_windows.cpp).
 void PolygonPolygon_FarApartTilted(benchmark::State& state) {
-  const auto count = static_cast<int>(state.range(0));
-  const PaddedPolygon polygon = regular_polygon(count, 1.0, 0.0);
-  const Pose origin, above({0, 0, 1e8}, {std::cos(0.5e-5), std::sin(0.5e-5), 0, 0});
-  for (auto _ : state) benchmark::DoNotOptimize(proximity(polygon, origin, polygon, above));
-  state.SetComplexityN(count);
+  run_unit_polygons(state, Pose({0, 0, 1e8}, {std::cos(0.5e-5), std::sin(0.5e-5), 0, 0}));
 }
 BENCHMARK(PolygonPolygon_FarApartTilted)->Apply(large_polygon_sizes);
 
@@ -350,11 +351,7 @@ BENCHMARK(PolygonPolygon_FarApartTilted)->Apply(large_polygon_sizes);
 // parallel faces across their mean normal (polygon_polygon.cpp, level_and_apart). Swept as
 // apart polygons they took 1.3 s at 8,000 vertices, growing as k^2.
 void PolygonPolygon_FarApartLevel(benchmark::State& state) {
-  const auto count = static_cast<int>(state.range(0));
-  const PaddedPolygon polygon = regular_polygon(count, 1.0, 0.0);
-  const Pose origin, above({0, 0, 1e8}, {std::cos(0.5e-8), std::sin(0.5e-8), 0, 0});
-  for (auto _ : state) benchmark::DoNotOptimize(proximity(polygon, origin, polygon, above));
-  state.SetComplexityN(count);
+  run_unit_polygons(state, Pose({0, 0, 1e8}, {std::cos(0.5e-8), std::sin(0.5e-8), 0, 0}));
 }
 BENCHMARK(PolygonPolygon_FarApartLevel)->Apply(large_polygon_sizes);
 
@@ -362,11 +359,7 @@ BENCHMARK(PolygonPolygon_FarApartLevel)->Apply(large_polygon_sizes);
 // second 1,000 to the side in the first's frame, where bounds along the plane rule nothing out
 // (65 ms at 4,000 vertices, growing as k^2); far pairs are swept by depth (separated_polygons.cpp).
 void PolygonPolygon_FarApartTiltedAside(benchmark::State& state) {
-  const auto count = static_cast<int>(state.range(0));
-  const PaddedPolygon polygon = regular_polygon(count, 1.0, 0.0);
-  const Pose origin, above({2.5, 0, 1e8}, {std::cos(0.5e-5), std::sin(0.5e-5), 0, 0});
-  for (auto _ : state) benchmark::DoNotOptimize(proximity(polygon, origin, polygon, above));
-  state.SetComplexityN(count);
+  run_unit_polygons(state, Pose({2.5, 0, 1e8}, {std::cos(0.5e-5), std::sin(0.5e-5), 0, 0}));
 }
 BENCHMARK(PolygonPolygon_FarApartTiltedAside)->Apply(large_polygon_sizes);
 
@@ -375,8 +368,7 @@ BENCHMARK(PolygonPolygon_FarApartTiltedAside)->Apply(large_polygon_sizes);
 // each crosses the other's plane. Two polygons are solved at their cores' own tolerances
 // (pair_setup.hpp, search_tolerances); at the scene's, both were taken whole and swept
 // (0.35 s at 8,000 vertices, 1.6-1.9 s at 40,000).
-PaddedPolygon needle(int count, double phase) {
-  const double length = 2e-11;
+PaddedPolygon needle(int count, double phase, double length = 2e-11) {
   Eigen::MatrixX2d C(count, 2);
   Eigen::VectorXd d(count);
   const auto at = [&](int k) {
@@ -410,6 +402,18 @@ void PolygonPolygon_SignedDistanceNeedles(benchmark::State& state) {
   state.SetComplexityN(count);
 }
 BENCHMARK(PolygonPolygon_SignedDistanceNeedles)->Apply(large_polygon_sizes);
+// The same needles shrunk by 1e-95 (2e-106 long beside radii of 1), below the 1e-100 of the
+// frame under which cores keep the frame's tolerances: the signed distance solves them in a frame
+// of their own (signed_distance.cpp); at the frame's tolerances every facet tied (1.8 s at 8,000
+// vertices, 7.7 s at 16,000).
+void PolygonPolygon_SignedDistanceTinyNeedles(benchmark::State& state) {
+  const auto count = static_cast<int>(state.range(0));
+  const PaddedPolygon a = needle(count, 0.0, 2e-106), b = needle(count, 0.3, 2e-106);
+  const Pose origin, crossing({1e-109, 0, 0}, {std::sqrt(0.5), 0, std::sqrt(0.5), 0});
+  for (auto _ : state) benchmark::DoNotOptimize(signed_distance(a, origin, b, crossing));
+  state.SetComplexityN(count);
+}
+BENCHMARK(PolygonPolygon_SignedDistanceTinyNeedles)->Apply(large_polygon_sizes);
 
 // Two k-gons crossing (the signed distance in penetration): the unit-circumradius k-gon at the
 // origin, the 0.7 one turned off its plane by 30 to 90 degrees about a random in-plane axis, its
