@@ -52,8 +52,9 @@
 //     taken, so the witnesses always lie on the two cores (penetration.hpp).
 //   - Tolerances are relative, as for proximity(): 1e-12 of the scene's size, or of the cores'
 //     own (the larger core and the distance between the body origins) where the radii make the
-//     scene, since the radii play no part in the cores' gap and depth (cores below 1e-100 of the
-//     radii are solved in a frame of their own size); and every input
+//     scene, since the radii play no part in the cores' gap and depth (cores 1e-140 to 1e-100 of
+//     the radii are solved in a frame of their own size; smaller ones keep the scene's tolerances
+//     and touch at any gap); and every input
 //     proximity() accepts is answered at every magnitude; scaling all lengths by 2^k scales
 //     distance and the points by 2^k, the gradient's quaternion part by 2^k, exactly.
 //

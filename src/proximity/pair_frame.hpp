@@ -48,8 +48,8 @@ struct PairFrame {
 // radii of 1 have ~1,400 of 10^5 vertices within it of a support line (polygon_windows.cpp,
 // penetration.hpp). Cores below 1e-100 of the frame's units keep the frame's: the searches form
 // products of two core lengths (squared distances, values along a direction), which must stay far
-// from underflow (below ~1e-154 they lose every digit). (The signed distance solves such cores in
-// a frame of their own instead: signed_distance.cpp, solve_at_cores_scale.)
+// from underflow (below ~1e-154 they lose every digit). (The signed distance solves such cores,
+// down to 1e-140, in a frame of their own instead: signed_distance.cpp, solve_at_cores_scale.)
 struct CoreTolerances {
   double intersection = 0.0;
   double tie = 0.0;

@@ -172,17 +172,19 @@ SignedSolution solve(const PaddedPolygon& a, const PosedCore& pa, const PaddedPo
 // apply, and the solution is carried back by the ratio of the two frames' scales, a power of two,
 // exactly: the gap and the points' body coordinates scale, the normal, its source and the points'
 // free directions (directions) do not. The cores' scene is the larger core size and the distance
-// between the body origins, as in core_tolerances; a scene of zero (two coincident points) has
-// nothing to search.
+// between the body origins, as in core_tolerances. Only down to 1e-140: the result is still built
+// in the radii's frame (signed_distance_result.hpp), whose derivatives take products of the gap
+// with itself, and a gap that this search resolves, 1e-12 of the cores, stays above 1e-152 there,
+// its square a normal double (below ~1e-160 of the radii the points' Jacobian came out infinite:
+// a hostile review). Smaller cores keep the frame's tolerances, touching at any gap, as before.
 template <class ShapeA, class ShapeB>
 SignedSolution solve_at_cores_scale(const ShapeA& a, const Pose& pose_a, const PosedCore& pa,
                                     const ShapeB& b, const Pose& pose_b, const PosedCore& pb,
                                     const PairFrame& frame) {
   const double cores = std::max({pa.size, pb.size, (pb.r - pa.r).norm()});
-  if (!(cores > 0.0 && cores < 1e-100)) return solve(a, pa, b, pb, frame);
-  const PairFrame core_frame = detail::make_pair_frame(detail::core_size(a), 0.0,
-                                                       detail::core_size(b), 0.0, pose_a.r(),
-                                                       pose_b.r());
+  if (!(cores >= 1e-140 && cores < 1e-100)) return solve(a, pa, b, pb, frame);
+  const PairFrame core_frame = detail::make_pair_frame(
+      detail::core_size(a), 0.0, detail::core_size(b), 0.0, pose_a.r(), pose_b.r());
   const PosedCore core_a = detail::posed_core(a, pose_a, pose_a.r(), core_frame);
   const PosedCore core_b = detail::posed_core(b, pose_b, pose_a.r(), core_frame);
   SignedSolution solution = solve(a, core_a, b, core_b, core_frame);
