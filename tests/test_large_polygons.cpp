@@ -320,6 +320,42 @@ TestShape needle(int count, double phase, double radius) {
   return out;
 }
 
+// `shape` scaled by `factor` (the rows keep their normals, the offsets scale), padded by `radius`.
+TestShape shrunk(const TestShape& shape, double factor, double radius) {
+  const auto& polygon = std::get<PaddedPolygon>(shape.shape);
+  TestShape out{
+      PaddedPolygon(polygon.constraint_matrix(), factor * polygon.constraint_offsets(), radius),
+      shape.body_vertices, factor * shape.size};
+  for (Eigen::Vector3d& vertex : out.body_vertices) vertex *= factor;
+  return out;
+}
+
+// Two needles (radius 1, shrunk by `factor`) crossing or within a few widths at a random pose,
+// and their cores' signed gap by the brute force: the distance when apart, else minus the
+// separating-axis depth.
+struct NeedlePair {
+  TestShape a, b;
+  Pose pa, pb;
+  long double apart = 0.0;
+  double gap = 0.0;
+};
+NeedlePair random_needle_pair(Rng& rng, std::normal_distribution<double>& normal, int trial,
+                              double factor) {
+  NeedlePair out{shrunk(needle(36 + trial, 0.0, 1.0), factor, 1.0),
+                 shrunk(needle(40 + 2 * trial, 0.3, 1.0), factor, 1.0),
+                 Pose(),
+                 Pose(),
+                 0.0,
+                 0.0};
+  const Eigen::Vector4d q(normal(rng), normal(rng), normal(rng), normal(rng));
+  out.pb = Pose(
+      1e-3 * factor * kNeedleLength * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)), q);
+  const WorldCore wa = to_world(out.a, out.pa), wb = to_world(out.b, out.pb);
+  out.apart = brute_force_closest(wa, wb).distance;
+  out.gap = static_cast<double>(out.apart > 0 ? out.apart : -brute_force_penetration_depth(wa, wb));
+  return out;
+}
+
 // Needles far thinner than the tolerance their radii set (the radii make the scene): 1000:1
 // ellipses 4e-11 long, radius 1 or 0, at random poses within a few needle lengths. Before two
 // polygons were solved at their cores' own tolerances (pair_setup.hpp, search_tolerances), every
@@ -376,21 +412,14 @@ TEST(LargePolygons, NeedleSignedDistancesThinnerThanTheTolerance) {
   int penetrating = 0;
   for (int trial = 0; trial < 30; ++trial) {
     SCOPED_TRACE(::testing::Message() << "trial " << trial);
-    const TestShape a = needle(36 + trial, 0.0, 1.0), b = needle(40 + 2 * trial, 0.3, 1.0);
-    const Eigen::Vector4d q(normal(rng), normal(rng), normal(rng), normal(rng));
-    const Pose pa(Eigen::Vector3d::Zero(), kIdentity);
-    const Pose pb(1e-3 * kNeedleLength * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)), q);
-    const WorldCore wa = to_world(a, pa), wb = to_world(b, pb);
-    const long double apart = brute_force_closest(wa, wb).distance;
-    const double gap =
-        static_cast<double>(apart > 0 ? apart : -brute_force_penetration_depth(wa, wb));
-    penetrating += apart > 0 ? 0 : 1;
-    const auto& padded_a = std::get<PaddedPolygon>(a.shape);
-    const auto& padded_b = std::get<PaddedPolygon>(b.shape);
-    const SignedDistance ab = signed_distance(padded_a, pa, padded_b, pb);
-    const SignedDistance ba = signed_distance(padded_b, pb, padded_a, pa);
+    const NeedlePair pair = random_needle_pair(rng, normal, trial, 1.0);
+    penetrating += pair.apart > 0 ? 0 : 1;
+    const auto& padded_a = std::get<PaddedPolygon>(pair.a.shape);
+    const auto& padded_b = std::get<PaddedPolygon>(pair.b.shape);
+    const SignedDistance ab = signed_distance(padded_a, pair.pa, padded_b, pair.pb);
+    const SignedDistance ba = signed_distance(padded_b, pair.pb, padded_a, pair.pa);
     // distance = gap - 2 in a frame of scene 2: a few ulps of 2.
-    EXPECT_NEAR(ab.distance + 2.0, gap, 2e-15);
+    EXPECT_NEAR(ab.distance + 2.0, pair.gap, 2e-15);
     EXPECT_EQ(ab.distance, ba.distance);
     EXPECT_LE((ab.normal + ba.normal).norm(), 1e-12);
   }
@@ -410,32 +439,18 @@ TEST(LargePolygons, NeedleSignedDistancesBelow1e100OfTheirRadii) {
   int penetrating = 0;
   for (int trial = 0; trial < 30; ++trial) {
     SCOPED_TRACE(::testing::Message() << "trial " << trial);
-    TestShape a = needle(36 + trial, 0.0, 1.0), b = needle(40 + 2 * trial, 0.3, 1.0);
-    for (TestShape* shape : {&a, &b}) {
-      const auto& polygon = std::get<PaddedPolygon>(shape->shape);
-      shape->shape =
-          PaddedPolygon(polygon.constraint_matrix(), shrink * polygon.constraint_offsets(), 1.0);
-      for (Eigen::Vector3d& vertex : shape->body_vertices) vertex *= shrink;
-      shape->size *= shrink;
-    }
-    const Eigen::Vector4d q(normal(rng), normal(rng), normal(rng), normal(rng));
-    const Pose pa(Eigen::Vector3d::Zero(), kIdentity);
-    const Pose pb(1e-3 * length * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)), q);
-    const WorldCore wa = to_world(a, pa), wb = to_world(b, pb);
-    const long double apart = brute_force_closest(wa, wb).distance;
-    const double gap =
-        static_cast<double>(apart > 0 ? apart : -brute_force_penetration_depth(wa, wb));
-    penetrating += apart > 0 ? 0 : 1;
-    const auto& padded_a = std::get<PaddedPolygon>(a.shape);
-    const auto& padded_b = std::get<PaddedPolygon>(b.shape);
-    const SignedDistance ab = signed_distance(padded_a, pa, padded_b, pb);
-    const SignedDistance ba = signed_distance(padded_b, pb, padded_a, pa);
+    const NeedlePair pair = random_needle_pair(rng, normal, trial, shrink);
+    penetrating += pair.apart > 0 ? 0 : 1;
+    const auto& padded_a = std::get<PaddedPolygon>(pair.a.shape);
+    const auto& padded_b = std::get<PaddedPolygon>(pair.b.shape);
+    const SignedDistance ab = signed_distance(padded_a, pair.pa, padded_b, pair.pb);
+    const SignedDistance ba = signed_distance(padded_b, pair.pb, padded_a, pair.pa);
     const auto core_gap = [](const SignedDistance& s) {
       return (s.core_points[1] - s.core_points[0]).dot(s.normal);
     };
-    EXPECT_NEAR(core_gap(ab), gap, 1e-12 * length);
-    EXPECT_NEAR(core_gap(ba), gap, 1e-12 * length);
-    EXPECT_EQ(ab.penetrating, apart <= 0);
+    EXPECT_NEAR(core_gap(ab), pair.gap, 1e-12 * length);
+    EXPECT_NEAR(core_gap(ba), pair.gap, 1e-12 * length);
+    EXPECT_EQ(ab.penetrating, pair.apart <= 0);
     EXPECT_LE((ab.normal + ba.normal).norm(), 1e-12);
     EXPECT_LE((ab.core_points[0] - ba.core_points[1]).norm(), 1e-12 * length);
   }
@@ -454,16 +469,8 @@ TEST(LargePolygons, CoresFarSmallerThanTheirRadii) {
   for (int trial = 0; trial < 24; ++trial) {
     SCOPED_TRACE(::testing::Message() << "trial " << trial);
     const double size = std::pow(10.0, -9.3 + 0.15 * trial);
-    TestShape a = many_sided(rng, 40 + trial, trial % 4 == 0);
-    TestShape b = many_sided(rng, 45 + trial, trial % 5 == 0);
-    // Shrunk to `size` (the rows keep their normals, the offsets scale), padded by 1.
-    for (TestShape* shape : {&a, &b}) {
-      const auto& polygon = std::get<PaddedPolygon>(shape->shape);
-      shape->shape =
-          PaddedPolygon(polygon.constraint_matrix(), size * polygon.constraint_offsets(), 1.0);
-      for (Eigen::Vector3d& vertex : shape->body_vertices) vertex *= size;
-      shape->size *= size;
-    }
+    const TestShape a = shrunk(many_sided(rng, 40 + trial, trial % 4 == 0), size, 1.0);
+    const TestShape b = shrunk(many_sided(rng, 45 + trial, trial % 5 == 0), size, 1.0);
     const Pose pa(size * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)),
                   Eigen::Vector4d(normal(rng), normal(rng), normal(rng), normal(rng)));
     const Pose pb(pa.r() + 2.5 * size * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)),

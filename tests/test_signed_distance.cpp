@@ -680,5 +680,47 @@ TEST(SignedDistance, CoresFarSmallerThanTheirRadiiKeepTheirGap) {
   }
 }
 
+// Cores 1e-105 to 1e-135 of their radii, apart (two capsules' segments 20 degrees apart in
+// direction and 0.9 of their length apart, the closest points inside both): their signed distance
+// is solved in the cores' own frame (signed_distance.cpp), where |sin| = 0.34 is below |d| over
+// the frame's unit, and was returned with the normal's source chosen there, d / |d|, whose
+// derivative in the radii's frame divides the points' rounding (ulps of the radii) by the gap: the
+// normal's Jacobian came out 1e90 to 1e117 times too large (a hostile review). The same scene with
+// the cores 2^m larger (~1e-60 of the radii, the radii kept) is the reference: the normal equal,
+// its Jacobian's position columns scaled by 2^m, its rotation columns equal, and the Hessian's
+// position block scaled by 2^m and its rotation block by 2^-m, to 1e-9 of their size.
+TEST(SignedDistance, TinyCoresApartKeepTheirDerivatives) {
+  const auto scene = [](double length) {
+    return std::array<Pose, 2>{
+        Pose(Eigen::Vector3d::Zero(), kIdentity),
+        Pose(length * Eigen::Vector3d(0.3, 0.1, 0.9), about(M_PI / 9, 0, 0, 1))};
+  };
+  const std::array<int, 6> positions = {0, 1, 2, 7, 8, 9};
+  const std::array<int, 8> rotations = {3, 4, 5, 6, 10, 11, 12, 13};
+  for (const double length : {1e-105, 1e-120, 1e-135}) {
+    SCOPED_TRACE(::testing::Message() << "length " << length);
+    const double factor = std::exp2(std::round(std::log2(1e-60 / length)));
+    const Capsule a(length, 1.0), b(length, 0.5);
+    const Capsule a_ref(length * factor, 1.0), b_ref(length * factor, 0.5);
+    const std::array<Pose, 2> poses = scene(length), poses_ref = scene(length * factor);
+    const SignedDistanceHessian h = signed_distance_hessian(a, poses[0], b, poses[1]);
+    const SignedDistanceHessian ref =
+        signed_distance_hessian(a_ref, poses_ref[0], b_ref, poses_ref[1]);
+    ASSERT_FALSE(h.penetrating);
+    EXPECT_LE((h.normal - ref.normal).norm(), 1e-12);
+    Eigen::Matrix<double, 3, 14> expected = ref.normal_jacobian;
+    Eigen::Matrix<double, 14, 14> expected_hessian = ref.hessian;
+    for (const int i : positions) {
+      expected.col(i) *= factor;
+      for (const int j : positions) expected_hessian(i, j) *= factor;
+    }
+    for (const int i : rotations) {
+      for (const int j : rotations) expected_hessian(i, j) /= factor;
+    }
+    EXPECT_LE((h.normal_jacobian - expected).norm(), 1e-9 * expected.norm());
+    EXPECT_LE((h.hessian - expected_hessian).norm(), 1e-9 * expected_hessian.norm());
+  }
+}
+
 }  // namespace
 }  // namespace diffpills::testing

@@ -191,6 +191,20 @@ SignedSolution solve_at_cores_scale(const ShapeA& a, const Pose& pose_a, const P
   const double to_frame = core_frame.scale * frame.inverse_scale;
   solution.gap *= to_frame;
   for (detail::ClosestFeature& side : solution.sides) side.body_point *= to_frame;
+  if (!solution.penetrating) {
+    // The normal's source decided again where the result is built. Apart, it was chosen for the
+    // cores' frame, where d = x2 - x1 is as large as the cores and d / |d| is accurate; in the
+    // radii's frame the points' motion carries errors of ulps of the radii, which d / |d|'s
+    // derivative divides by |d|: the normal's Jacobian came out 1e90 to 1e117 times too large
+    // for cores 1e-107 to 1e-134 of their radii (a hostile review, against the same scene with
+    // the cores 2^m larger). There contact_normal.hpp's rule takes the features' normal (a face's,
+    // or e x f) wherever it is the better conditioned, as it does for such cores' proximity.
+    const Eigen::Vector3d x1 = pa.r + pa.attitude.matrix() * solution.sides[0].body_point;
+    const Eigen::Vector3d x2 = pb.r + pb.attitude.matrix() * solution.sides[1].body_point;
+    solution.source = detail::points_normal_source(pa, solution.sides[0], pb, solution.sides[1],
+                                                   x2 - x1, frame.unit);
+    solution.normal = detail::source_normal(solution.source, pa, pb, x2 - x1);
+  }
   return solution;
 }
 
