@@ -88,7 +88,7 @@ bool plane_section(const CarriedPolygon<PolygonView>& W, const Eigen::Vector3d& 
 
 // Level faces apart: each polygon's heights over the other's plane vary by less than the
 // rounding of the coordinates, 64 ulps of their magnitude (B's origin's distance plus both
-// extents; at most the tie tolerance), so that no computation in either frame can order them,
+// extents; at most the tie tolerance), so that the distances of all their feature pairs tie,
 // and B lies wholly on one side of A's plane beyond the intersection tolerance. (Not the whole tie
 // tolerance: where the polygons are near each other its part of 2e-12 of their size would also
 // take in tilts just past the 1e-12 of parallel planes, whose lowest vertex or edge is the
