@@ -240,16 +240,18 @@ TEST(LargePolygons, TiesAndFacesMatchTheEnumeration) {
 }
 
 // Large windows of polygons within 1,000 intersection tolerances of their size ("specks", as two
-// polygons 1e12 times their size apart are): the sweep orders them by depth along the line between
-// them, or, close to each other, keeps its order with a band of 0, and solves only pairs that can
-// be closer than the best. Exercised where the brute force is exact: polygons of size ~1 given a
-// tolerance of 1,000, at distances of 0.5 and 100 sizes beyond touching, in both orders, with
-// random poses: the sweep called on windows holding every vertex, and the windows (which take
-// both polygons whole at that tolerance) on the same pairs. In the public queries polygons reach
-// the sweep's speck regimes where the distance makes the scene (PolygonPolygon_FarApart); where
-// radii make it, two polygons are solved at their cores' own tolerances (pair_setup.hpp) and are
-// specks only as the bare cores would be. No bound may leave out a closer pair: both distances are
-// the brute force's to rounding. (Their cost, k log k against ka kb before: BENCHMARKS.md.)
+// polygons 1e12 times their size apart are): apart by more than their extents, they are searched in
+// hierarchies bounding depth along the line between them and offset across it
+// (depth_box_tree.hpp); close to each other, the sweep keeps its order with a band of 0. Either
+// solves only pairs that can be closer than the best. Exercised where the brute force is exact:
+// polygons of size ~1 given a tolerance of 1,000, at distances of 0.5 and 100 sizes beyond
+// touching, in both orders, with random poses: the sweep called on windows holding every vertex,
+// and the windows (which take both polygons whole at that tolerance) on the same pairs. In the
+// public queries polygons reach the sweep's speck regimes where the distance makes the scene
+// (PolygonPolygon_FarApart); where radii make it, two polygons are solved at their cores' own
+// tolerances (pair_setup.hpp) and are specks only as the bare cores would be. No bound may leave
+// out a closer pair: both distances are the brute force's to rounding. (Their cost, about linear
+// against ka kb before: BENCHMARKS.md.)
 TEST(LargePolygons, SpeckSweepLeavesNoCloserPairOut) {
   Rng rng(41);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
@@ -695,16 +697,43 @@ TEST(LargePolygons, FarApartTiltedFaces) {
   }
 }
 
-// Polygons 1e5 to 1e9 times their size apart, tilted 1e-9 to 1e-3 rad about a random line of the
-// plane and moved 0 to 3 sizes to the side, so that B's lowest vertex is over A's face, over its
-// rim or beside it. A tilt carries B the distance times the tilt to the side in A's frame, where
-// the bounds along A's plane then ruled nothing out: two unit 4,000-gons 1e8 apart, 2.5 to the
-// side, tilted 1e-5 rad took 65 ms, growing as k^2 (the windows are swept by depth now,
-// separated_polygons.cpp). The cores' distance stays the brute force's to 64 ulps of the distance
-// in both orders, each point on its core, and the two orders return the same points.
+// B `height` above A, tilted by `tilt` about a random line of its plane and moved `aside` in a
+// random direction. The cores' distance stays the brute force's to 64 ulps of the distance in both
+// orders, each point on its core, and the two orders return the same points.
+void expect_far_tilted_pair_matches_brute_force(Rng& rng, const TestShape& a, const TestShape& b,
+                                                double height, double tilt, double aside) {
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double heading = 2.0 * M_PI * uniform(rng), axis = 2.0 * M_PI * uniform(rng);
+  const Pose pa(Eigen::Vector3d::Zero(), kIdentity);
+  const Pose pb(Eigen::Vector3d(aside * std::cos(heading), aside * std::sin(heading), height),
+                about(tilt, std::cos(axis), std::sin(axis), 0));
+  const double reference =
+      static_cast<double>(brute_force_closest(to_world(a, pa), to_world(b, pb)).distance);
+  const auto& core_a = std::get<PaddedPolygon>(a.shape);
+  const auto& core_b = std::get<PaddedPolygon>(b.shape);
+  const Proximity ab = proximity(core_a, pa, core_b, pb);
+  const Proximity ba = proximity(core_b, pb, core_a, pa);
+  const double within = 64 * std::numeric_limits<double>::epsilon() * height;
+  EXPECT_NEAR((ab.core_points[1] - ab.core_points[0]).norm(), reference, within);
+  EXPECT_NEAR((ba.core_points[1] - ba.core_points[0]).norm(), reference, within);
+  EXPECT_NEAR(ab.core_points[0].z(), 0.0, 1e-12);
+  EXPECT_LE((ab.core_points[0] - ba.core_points[1]).norm(), 1e-15 * height);
+  EXPECT_LE((ab.core_points[1] - ba.core_points[0]).norm(), 1e-15 * height);
+  // B's point on B's plane.
+  const Eigen::Vector4d& q = pb.q();
+  const Eigen::Vector3d normal_b =
+      Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized().toRotationMatrix().col(2);
+  EXPECT_NEAR(normal_b.dot(ab.core_points[1] - pb.r()), 0.0, 1e-15 * height);
+}
+
+// Polygons 1e5 to 1e9 times their size apart, tilted 1e-9 to 1e-3 rad and moved 0 to 1.5 sums of
+// their sizes to the side, so that B's lowest vertex is over A's face, over its rim or beside it.
+// A tilt carries B the distance times the tilt to the side in A's frame, where the bounds along
+// A's plane then ruled nothing out: two unit 4,000-gons 1e8 apart, 2.5 to the side, tilted 1e-5
+// rad took 65 ms, growing as k^2 (far windows are searched in depth_box_tree.hpp's hierarchies
+// now, separated_polygons.cpp).
 TEST(LargePolygons, FarApartTiltedToTheSide) {
   Rng rng(73);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
   for (int trial = 0; trial < 24; ++trial) {
     SCOPED_TRACE(::testing::Message() << "trial " << trial);
     const TestShape a = many_sided(rng, 100 + trial, trial % 3 == 0);
@@ -712,27 +741,29 @@ TEST(LargePolygons, FarApartTiltedToTheSide) {
     const double height = std::pow(10.0, 5.0 + (trial % 9) * 0.5);
     const double tilt = std::pow(10.0, -9.0 + (trial % 7));
     const double aside = (trial % 4) * 0.5 * (a.size + b.size);  // 0 to 1.5 (sum of sizes)
-    const double heading = 2.0 * M_PI * uniform(rng), axis = 2.0 * M_PI * uniform(rng);
-    const Pose pa(Eigen::Vector3d::Zero(), kIdentity);
-    const Pose pb(Eigen::Vector3d(aside * std::cos(heading), aside * std::sin(heading), height),
-                  about(tilt, std::cos(axis), std::sin(axis), 0));
-    const double reference =
-        static_cast<double>(brute_force_closest(to_world(a, pa), to_world(b, pb)).distance);
-    const auto& core_a = std::get<PaddedPolygon>(a.shape);
-    const auto& core_b = std::get<PaddedPolygon>(b.shape);
-    const Proximity ab = proximity(core_a, pa, core_b, pb);
-    const Proximity ba = proximity(core_b, pb, core_a, pa);
-    const double within = 64 * std::numeric_limits<double>::epsilon() * height;
-    EXPECT_NEAR((ab.core_points[1] - ab.core_points[0]).norm(), reference, within);
-    EXPECT_NEAR((ba.core_points[1] - ba.core_points[0]).norm(), reference, within);
-    EXPECT_NEAR(ab.core_points[0].z(), 0.0, 1e-12);
-    EXPECT_LE((ab.core_points[0] - ba.core_points[1]).norm(), 1e-15 * height);
-    EXPECT_LE((ab.core_points[1] - ba.core_points[0]).norm(), 1e-15 * height);
-    // B's point on B's plane.
-    const Eigen::Vector4d& q = pb.q();
-    const Eigen::Vector3d normal_b =
-        Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized().toRotationMatrix().col(2);
-    EXPECT_NEAR(normal_b.dot(ab.core_points[1] - pb.r()), 0.0, 1e-15 * height);
+    expect_far_tilted_pair_matches_brute_force(rng, a, b, height, tilt, aside);
+  }
+}
+
+// The poses where both of the earlier sweeps (by depth along the line between the polygons, and
+// along A's plane) stayed quadratic: many-sided polygons 1e6 to 1e8 times their size apart, tilted
+// 1e-8 to 1e-5 rad, 0.5 to 2.5 sums of their sizes to the side. There the distance varies across
+// the polygons by a slope (the tilt, and the offset over the distance) and by the offset across
+// the line between them squared over twice the distance, both near the distance's rounding; each
+// sweep's bound held one of the two (unit 32,000-gons 3e6 apart, 2.5 to the side, tilted 1e-6 rad:
+// 0.66 s). The hierarchies' bound holds both; the answers stay the brute force's, with windows of
+// hundreds of vertices on each side.
+TEST(LargePolygons, FarApartNearlyFacingManySided) {
+  Rng rng(79);
+  const double heights[] = {1e6, 3e6, 1e7, 1e8};
+  const double tilts[] = {1e-8, 1e-6, 1e-5};
+  for (int trial = 0; trial < 12; ++trial) {
+    SCOPED_TRACE(::testing::Message() << "trial " << trial);
+    const TestShape a = many_sided(rng, 700 + 37 * trial, trial % 5 == 0);
+    const TestShape b = many_sided(rng, 900 + 41 * trial, false);
+    const double aside = (0.5 + (trial % 3)) * (a.size + b.size);  // 0.5 to 2.5 sums of sizes
+    expect_far_tilted_pair_matches_brute_force(rng, a, b, heights[trial % 4], tilts[trial % 3],
+                                               aside);
   }
 }
 

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "depth_box_tree.hpp"
 #include "segment_bounds.hpp"
 
 namespace diffpills::detail {
@@ -346,46 +347,54 @@ std::vector<Eigen::Index> sorted_by(Eigen::Index count, const Key& key) {
   return sorted_by(std::move(all), key);
 }
 
-// Polygons far smaller than their distance ("specks": both within 1,000 intersection tolerances,
-// 1e-9 of the scene). Every pair of their features is then within the tolerance band of the
-// best, no bound along the plane or across it rules any out, and the sweep below met all ka kb
-// pairs: two 8,000-gons 1e13 times their size apart took 2.6 s (a hostile review; 10^5-gons would
-// take minutes). For them the pairs are ordered by depth along u, the unit direction between the
-// polygons' boxes: for any unit u and points p of A's edge i, q of B's edge j,
-//   |q - p| >= u . (q - p) >= low_j - high_i,
-// with low_j the least u . q over edge j's ends and high_i the largest u . p over edge i's. With
-// B's edges sorted by low_j and A's by high_i decreasing (the support first, which seeds the best
-// distance), each A edge stops at the first B edge this bound rules out: about the supports' few
-// pairs each, k log k in all. The band is 0 here (a pair is solved only if it can be closer, not
-// merely tie): ties at the tolerance span the whole polygons, and the choice among them moves the
-// points by at most the polygons' size, within 1e-9 of the scene.
+// Polygons far apart compared to their size (a distance over 1,000 times their extents), and specks
+// (both within 1,000 intersection tolerances, 1e-9 of the scene). There every pair's distance is
+// the distance between the polygons plus small terms, and the bounds of the sweep below, along A's
+// plane and across it, rule few pairs out: two 8,000-gons 1e13 times their size apart took 2.6 s (a
+// hostile review). A sweep by depth along the line between the polygons, used here before, fixed
+// those but was blind to the offset across that line: over A's face (4,000-gons 1e4 apart, 0.5 to
+// the side, tilted 1e-10 rad: 123 ms, against 2.3 ms along the plane; a hostile review), and for
+// faces 1e6 to 1e8 apart, tilted 1e-8 to 1e-6 rad and a few sizes to the side (16,000-gons 1e7
+// apart, 1e-6 rad, 2.5 aside: 175 ms), both grew as k^2. Their pairs are searched in
+// depth_box_tree.hpp's hierarchies, whose bound holds a pair's depth and its offset across, in two
+// frames: A's normal, in which A's chains have no depth and B's only their tilt (the closest pairs
+// of faces over each other), and u, the unit direction between the polygons' boxes (those to the
+// side). Measured on seven poses of unit 32,000-gons (1e4 to 1e8 apart, 1e-10 to 1e-5 rad, 0.5 to
+// 10 aside), the worst visited 544,000 edge pairs with u alone, 224,000 with A's normal alone and
+// 51,000 with both. The band is 0 (a pair is solved only if it can be closer, not merely tie): ties
+// at the tolerance can span the whole polygons, and the choice among them moves the points by at
+// most the polygons' size, within 1e-9 of the scene.
 // Rounding: the depths are dot products with coordinates as large as the distance, so for polygons
-// below ~1e-15 of it every low_j (and high_i) is the same number to a few ulps, and a computed
-// distance may exceed that bound by its own rounding: no A edge met the break, and every pair was
-// solved (two 8,000-gons 1e30 times their size apart: 0.92 s; helper-4). A pair whose bound is
-// within `slack` (a few ulps of the coordinates) of the best distance is a tie at rounding and is
-// left out too.
+// below ~1e-15 of it every depth is the same number to a few ulps, and a computed distance may
+// exceed its bound by its own rounding: every pair would be solved (two 8,000-gons 1e30 times their
+// size apart: 0.92 s; helper-4). A pair whose bound is within `slack` (a few ulps of the
+// coordinates) of the best distance is a tie at rounding and is left out too.
 template <class Polygon>
-void sweep_specks(const Polygon& a, const CarriedPolygon<Polygon>& W,
-                  const SmallBuffer<Segment>& b_edges, const Eigen::Vector3d& u, double slack,
-                  Best& best) {
-  const auto depth_a = [&](Eigen::Index i) { return u.head<2>().dot(a.vertex(i)); };
-  const auto high = [&](Eigen::Index i) {
-    return std::max(depth_a(i == 0 ? a.size() - 1 : i - 1), depth_a(i));
-  };
-  const auto low = [&](Eigen::Index j) { return std::min(u.dot(W.start(j)), u.dot(W.end(j))); };
-  const std::vector<Eigen::Index> a_order =
-      sorted_by(a.size(), [&](Eigen::Index i) { return -high(i); });
-  const std::vector<Eigen::Index> b_order = sorted_by(W.size(), low);
-  double reach = std::sqrt(best.point.distance2);
-  for (const Eigen::Index i : a_order) {
-    const Segment edge = a.edge(i);
-    const double top = high(i);
-    for (const Eigen::Index j : b_order) {
-      if (low(j) - top >= reach - slack) break;
-      solve_edge_pair(edge, i, b_edges[j], j, 0.0, reach, best);
+void search_by_depth(const Polygon& a, const CarriedPolygon<Polygon>& W,
+                     const SmallBuffer<Segment>& b_edges, const Eigen::Vector3d& u, double slack,
+                     Best& best) {
+  DepthFrames frames;
+  frames[0] << 0, 0, 1, 1, 0, 0, 0, 1, 0;  // A's normal, then A's x and y
+  const Eigen::Vector3d e1 = u.unitOrthogonal();
+  frames[1].row(0) = u;
+  frames[1].row(1) = e1;
+  frames[1].row(2) = u.cross(e1);
+  const auto a_vertex = [&a](Eigen::Index i) { return lift(a.vertex(i)); };
+  const auto b_vertex = [&W](Eigen::Index j) { return W[j]; };
+  DepthBoxTree<decltype(a_vertex)> tree_a(a.size(), a_vertex, frames);
+  DepthBoxTree<decltype(b_vertex)> tree_b(W.size(), b_vertex, frames);
+  struct Pairs {
+    const Polygon& a;
+    const SmallBuffer<Segment>& b_edges;
+    double slack;
+    Best& best;
+    double reach;
+    double limit() const { return reach - slack; }
+    void visit(Eigen::Index i, Eigen::Index j) {
+      solve_edge_pair(a.edge(i), i, b_edges[j], j, 0.0, reach, best);
     }
-  }
+  } pairs{a, b_edges, slack, best, std::sqrt(best.point.distance2)};
+  search_close_edge_pairs(tree_a, tree_a.root(), tree_b, tree_b.root(), pairs);
 }
 
 // The direction along A's plane (z = 0 of A's frame) in which B's edge middles spread the most:
@@ -416,7 +425,7 @@ Eigen::Vector2d spread_axis(const SmallBuffer<EdgeBound>& bounds) {
 // 1e-11 rad from parallel took 2.3 s); here each A feature meets the B features of a thin slab,
 // about h1 + h2 + sqrt(2 d band) wide for edges by the bound along the plane (EdgeBound; with the
 // 3-D spheres' bound alone, ~sqrt(2 (h1 + h2) d), and the sweep grew as k^1.3). The pairs left out
-// are those the double loop's bounds rule out too. Specks go to sweep_specks.
+// are those the double loop's bounds rule out too. Specks and far windows go to search_by_depth.
 template <class Polygon>
 void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
                  const SmallBuffer<Segment>& b_edges, const SmallBuffer<EdgeBound>& b_bounds,
@@ -429,26 +438,12 @@ void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
   const Eigen::Vector3d apart = box_b.center() - lift(box_a.center());
   const double extents = box_a.diagonal().norm() + box_b.diagonal().norm();
   const bool specks = extents <= 1e3 * tolerance;
-  // Far apart compared to their size (a distance V over 1,000 times the windows' extents) and to
-  // the side of A's normal (B's box more than the extents off it along A's plane), or specks,
-  // points are swept by depth along the line between the boxes (sweep_specks). There the bounds
-  // along A's plane below are weak: a tilt theta carries B V theta to the side in A's frame, where
-  // every pair's lateral offset and height trade off within the best distance (two unit 4,000-gons
-  // 1e8 apart, 2.5 to the side, tilted 1e-5 rad: B 1,000 to the side, every pair visited, 65 ms and
-  // growing as k^2), while the depth bound misses a pair's distance only by the part across the
-  // line, at most extents^2 / (2 V), below the depths' spread along it (extents times the offset
-  // over V) once the offset exceeds the extents. Over A's face the depths' spread is that small
-  // part itself and the depth bound rules nothing out, while the bounds along the plane do (unit
-  // 4,000-gons 1e4 apart, 0.5 to the side, tilted 1e-10 rad: 123 ms by depth, 2.3 ms along the
-  // plane; a hostile review). Measured over 120 poses of unit 8,000-gons 1e4 to 1e8 apart, 0.5 to
-  // 40 aside: with the offset above 4 extents the sum 829 ms and the worst 142 ms, above 1 extent
-  // 490 and 45 ms, above half of them 366 and 39 ms (but 2.4x slower at 1e8, 1e-6 rad, 2.5 aside).
-  const bool aside = apart.head<2>().norm() > extents;
-  const bool by_depth =
-      apart.norm() > extents && (specks || (apart.norm() > 1e3 * extents && aside));
+  // Far apart compared to their size (a distance over 1,000 times the windows' extents), or
+  // specks: search_by_depth.
+  const bool by_depth = apart.norm() > extents && (specks || apart.norm() > 1e3 * extents);
   // Specks near each other (their radii make the scene, and they keep its tolerances: cores below
   // 1e-100 of the frame's units, pair_frame.hpp): the sweeps below with the band 0 of
-  // sweep_specks, for the same reason.
+  // search_by_depth, for the same reason.
   const double band = specks ? 0.0 : tie_tolerance;
   const Eigen::Vector2d axis = spread_axis(b_bounds);
   const auto along = [&axis](const Eigen::Vector3d& point) { return axis.dot(point.head<2>()); };
@@ -526,7 +521,7 @@ void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
 
   if (by_depth) {
     const double slack = 16 * std::numeric_limits<double>::epsilon() * (apart.norm() + extents);
-    sweep_specks(a, W, b_edges, apart.normalized(), slack, best);
+    search_by_depth(a, W, b_edges, apart.normalized(), slack, best);
     if (band > 0.0) sweep_edges(true, band);
     return;
   }

@@ -56,7 +56,8 @@ class CarriedPolygon {
 // that face, the middle of its part over it), and every pair of edges (the middle of their overlap
 // when parallel), the pairs whose lower bound exceeds the best distance by the tie band skipped
 // (the tie tolerance; windows larger than 32 x 32 vertex pairs keep it only for pairs that can
-// make an interval, and those far apart and to the side, or specks, are swept by depth), up to
+// make an interval, and those far apart, or specks, are searched in depth_box_tree.hpp's
+// hierarchies), up to
 // 32 x 32 vertex pairs with segment_bounds.hpp's vector bounds where the CPU has 4 lanes.
 // Candidates for a whole interval win ties within the tie tolerance (pair_frame.hpp).
 std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const PolygonView& b,
