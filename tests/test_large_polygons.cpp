@@ -459,6 +459,37 @@ TEST(LargePolygons, NeedleSignedDistancesBelow1e100OfTheirRadii) {
   EXPECT_GE(penetrating, 12);
 }
 
+// Shrunk by 1e-135 to 1e-185 (cores 2e-146 to 2e-196 long beside radii of 1): below 1e-140 of
+// the frame, cores keep its tolerances, which then exceed the whole pair, and touch at any gap
+// (signed_distance.hpp). The penetration search met every facet as a tie there (crossing needles
+// 1e-145 long: 1.5 s at 8,000 vertices, growing as k^2); they are answered without it. In both
+// orders: distance -2 exactly, touching (penetrating), opposite normals, finite derivatives, each
+// core point within its needle's length of its origin.
+TEST(LargePolygons, NeedleSignedDistancesBelow1e140OfTheirRadiiTouch) {
+  Rng rng(63);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int trial = 0; trial < 11; ++trial) {
+    SCOPED_TRACE(::testing::Message() << "trial " << trial);
+    const double shrink = std::pow(10.0, -135.0 - 5.0 * trial);
+    const NeedlePair pair = random_needle_pair(rng, normal, trial, shrink);
+    const SignedDistanceHessian ab =
+        signed_distance_hessian(pair.a.shape, pair.pa, pair.b.shape, pair.pb);
+    const SignedDistanceHessian ba =
+        signed_distance_hessian(pair.b.shape, pair.pb, pair.a.shape, pair.pa);
+    for (const SignedDistanceHessian* s : {&ab, &ba}) {
+      EXPECT_EQ(s->distance, -2.0);
+      EXPECT_TRUE(s->penetrating);
+      EXPECT_TRUE(s->gradient.allFinite());
+      EXPECT_TRUE(s->points_jacobian.allFinite() && s->core_points_jacobian.allFinite());
+      EXPECT_TRUE(s->hessian.allFinite());
+    }
+    EXPECT_LE((ab.normal + ba.normal).norm(), 1e-12);
+    const double length = shrink * kNeedleLength;
+    EXPECT_LE((ab.core_points[0] - pair.pa.r()).norm(), length);
+    EXPECT_LE((ab.core_points[1] - pair.pb.r()).norm(), length);
+  }
+}
+
 // Cores from 5e-10 to 1e-6 of the radii that make the scene (a hostile review: discs just above
 // the 1e-9 below which a pair counted as specks took 0.8-1.3 s at 10^5 vertices, 1,000x the same
 // cores with radius 0, with ~1,400 vertices of each within the scene's tolerance of a support), and

@@ -54,8 +54,8 @@
 //     own (the larger core and the distance between the body origins) where the radii make the
 //     scene, since the radii play no part in the cores' gap and depth (cores 1e-140 to 1e-100 of
 //     the radii are solved in a frame of their own size; smaller ones keep the scene's tolerances
-//     and touch at any gap); and every input
-//     proximity() accepts is answered at every magnitude; scaling all lengths by 2^k scales
+//     and touch at any gap: s = 0 and a normal held fixed, answered without a search); and every
+//     input proximity() accepts is answered at every magnitude; scaling all lengths by 2^k scales
 //     distance and the points by 2^k, the gradient's quaternion part by 2^k, exactly.
 //
 // Cost: that of proximity() apart; in penetration O(m) for a capsule and an m-gon. Two polygons

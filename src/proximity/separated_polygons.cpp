@@ -496,7 +496,7 @@ void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
     }
     const auto middle_x = [&](Eigen::Index j) { return along(b_bounds[j].middle); };
     const std::vector<Eigen::Index> sorted = sorted_by(std::move(edges), middle_x);
-    double reach = std::sqrt(best.point.distance2) + pass_band;
+    double reach = start_reach;
     for (Eigen::Index i = 0; i < a.size(); ++i) {
       const Segment edge = a.edge(i);
       const EdgeBound a_bound = edge_bound(edge, 0.0, 0.0);  // its height is not used here
