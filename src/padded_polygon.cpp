@@ -154,12 +154,15 @@ bool vertices_of(const std::vector<UnitRow>& kept, Eigen::MatrixX2d& vertices, d
 
 // The row C y <= d as n . y <= b with |n| = 1; false for a row that constrains nothing (C = 0, or
 // an offset beyond the largest double, a half-plane that holds every representable point).
+// The row is first scaled by a power of two to its largest entry in [1, 2), exactly, and n and b
+// are taken from that: a row and the same row times 2^k give the same n and b to the bit. Divided
+// by hypot(c0, c1) as given, a subnormal row's norm kept only the bits left above 2^-1074 (47 of
+// 53 for [-6e-317, -1e-309]), its normal differed from the rescaled row's in the last digits, and
+// so did the closest points (fuzz_proximity: the rows of a polygon rescaled to unit length, the
+// same polygon, gave other points).
 bool normalize_row(double c0, double c1, double d, UnitRow& row) {
   const double largest = std::max(std::abs(c0), std::abs(c1));
   if (largest == 0.0) return false;
-  const double norm = std::hypot(c0, c1);  // no overflow or underflow, unlike sqrt(c0^2 + c1^2)
-  row.normal = Eigen::Vector2d(c0 / norm, c1 / norm);
-  row.offset = d / norm;
   int exponent = 0;
   std::frexp(largest, &exponent);  // largest = f 2^exponent, f in [1/2, 1)
   // Each value times 2^(1 - exponent), not times that power formed first: for a subnormal row
@@ -168,6 +171,9 @@ bool normalize_row(double c0, double c1, double d, UnitRow& row) {
   // reported touching).
   row.scaled_row = Eigen::Vector2d(std::ldexp(c0, 1 - exponent), std::ldexp(c1, 1 - exponent));
   row.scaled_offset = std::ldexp(d, 1 - exponent);
+  const double norm = std::hypot(row.scaled_row.x(), row.scaled_row.y());  // in [1, 2 sqrt(2)]
+  row.normal = row.scaled_row / norm;
+  row.offset = row.scaled_offset / norm;
   return std::isfinite(row.offset) && std::isfinite(row.scaled_offset);
 }
 

@@ -155,6 +155,43 @@ TEST(Shapes, SubnormalRowsAreTheirHalfPlanes) {
   }
 }
 
+// Rows with subnormal entries are normalized as exactly as any other: a row and the same row
+// times 2^k are the same half-plane and give the same unit normal and offset to the bit. Rows of
+// entries near 2^-1060 keep ~14 bits (the spacing there is 2^-1074), and their norm taken as
+// given kept as few, so that normals were ~1e-4 from unit and the polygon ~1e-4 of its size off
+// (found by fuzz_proximity as other closest points for the rows rescaled to unit length).
+TEST(Shapes, SubnormalRowsGiveTheSamePolygonAsTheirRowsRescaled) {
+  const int k = 6;
+  Eigen::MatrixX2d subnormal(k, 2), rescaled(k, 2);
+  Eigen::VectorXd offsets(k), rescaled_offsets(k);
+  for (int i = 0; i < k; ++i) {
+    const double angle = 0.3 + 2.0 * std::acos(-1.0) * i / k + 0.05 * i * i;
+    const int exponent = -1060 + 3 * i;  // entries 2^-1060 .. 2^-1045, all subnormal
+    subnormal.row(i) << std::ldexp(std::cos(angle), exponent),
+        std::ldexp(std::sin(angle), exponent);
+    offsets(i) = 1e-300 * (1.0 + 0.1 * i);
+    // Scaling up by 2^-exponent is exact for both.
+    rescaled.row(i) << std::ldexp(subnormal(i, 0), -exponent),
+        std::ldexp(subnormal(i, 1), -exponent);
+    rescaled_offsets(i) = std::ldexp(offsets(i), -exponent);
+  }
+  const PaddedPolygon given(subnormal, offsets, 0.5);
+  const PaddedPolygon unit_rows(rescaled, rescaled_offsets, 0.5);
+  EXPECT_EQ(given.edge_normals(), unit_rows.edge_normals());
+  EXPECT_EQ(given.edge_offsets(), unit_rows.edge_offsets());
+  EXPECT_EQ(given.vertices(), unit_rows.vertices());
+  for (Eigen::Index j = 0; j < given.edge_normals().rows(); ++j) {
+    EXPECT_NEAR(given.edge_normals().row(j).norm(), 1.0, 1e-15);
+  }
+  const Capsule capsule(3e18, 1e17);
+  const Pose pose({1e19, 2e18, 3e18}, {0.9, 0.1, -0.3, 0.2});
+  const Proximity a = proximity(given, Pose(), capsule, pose);
+  const Proximity b = proximity(unit_rows, Pose(), capsule, pose);
+  EXPECT_EQ(a.phi, b.phi);
+  EXPECT_EQ(a.core_points, b.core_points);
+  EXPECT_EQ(a.gradient, b.gradient);
+}
+
 // A sliver far thinner than it is long, its rows at 0, 90, 180 and 270 degrees as cos and sin
 // give them (6e-17 off): x <= e, y <= e, -x <= e, -y <= 1 with e = 1e-300 down to 1e-20. The row
 // y <= e is dropped (it cuts 1e-284 of a polygon of size 1), leaving the rows x <= e and
