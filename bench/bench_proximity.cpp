@@ -321,7 +321,7 @@ BENCHMARK(PolygonPolygon_NearlyParallel)->Apply(large_polygon_sizes);
 // Two unit-circumradius k-gons 1e13 and 1e30 times their size apart (in the plane, along a
 // diagonal), alternately: far beyond the point where the intersection tolerance (1e-12 of the
 // scene) exceeds their size and every feature pair ties, and where rounding makes every depth along
-// the line between them the same number (separated_polygons.cpp, search_by_depth).
+// the line between them the same number (separated_polygons.cpp, search_point_candidates).
 void PolygonPolygon_FarApart(benchmark::State& state) {
   const auto count = static_cast<int>(state.range(0));
   const PaddedPolygon polygon = regular_polygon(count, 1.0, 0.0);
@@ -358,7 +358,7 @@ BENCHMARK(PolygonPolygon_FarApartLevel)->Apply(large_polygon_sizes);
 // The same k-gons 1e8 apart, tilted 1e-5 rad and moved 2.5 to the side: the tilt carries the
 // second 1,000 to the side in the first's frame, where bounds along the plane rule nothing out
 // (65 ms at 4,000 vertices, growing as k^2); far windows are searched in depth_box_tree.hpp's
-// hierarchies (separated_polygons.cpp, search_by_depth).
+// hierarchies (separated_polygons.cpp, search_point_candidates).
 void PolygonPolygon_FarApartTiltedAside(benchmark::State& state) {
   run_unit_polygons(state, Pose({2.5, 0, 1e8}, {std::cos(0.5e-5), std::sin(0.5e-5), 0, 0}));
 }
@@ -396,6 +396,22 @@ PaddedPolygon needle(int count, double phase, double length = 2e-11) {
   }
   return PaddedPolygon(C, d, 1.0);
 }
+
+// Two 1000:1 ellipses of k vertices (semi-axes 1e-3 and 1, radius 1), the second turned to face
+// the first 1e8 above it, tilted 1e-5 rad about their long axis and 0.5 along it: level faces,
+// laid flat into one plane where they lie 500 apart across their long sides. The sweep along the
+// plane, whose bound was the gap along their long axis, took every pair of the near-tie set there
+// (1.3 s at 64,000 vertices, growing as k^1.8; a hostile review); every large window is now
+// searched in the hierarchies (separated_polygons.cpp, search_large_windows).
+void PolygonPolygon_LevelEllipses(benchmark::State& state) {
+  const auto count = static_cast<int>(state.range(0));
+  const PaddedPolygon ellipse = needle(count, 0.1234, 1.0);
+  const double half = 0.5 * (M_PI + 1e-5);
+  const Pose facing({0, 0.5, 1e8}, {std::cos(half), 0, std::sin(half), 0});
+  for (auto _ : state) benchmark::DoNotOptimize(proximity(ellipse, Pose(), ellipse, facing));
+  state.SetComplexityN(count);
+}
+BENCHMARK(PolygonPolygon_LevelEllipses)->Apply(large_polygon_sizes);
 
 void PolygonPolygon_Needles(benchmark::State& state) {
   const auto count = static_cast<int>(state.range(0));

@@ -1,7 +1,7 @@
-// A bounding hierarchy over a polygon's edges for the closest pair of two polygons far apart
-// (separated_polygons.cpp): each node is a chain of consecutive edges with, in each of a few
-// orthonormal frames, the interval of its depths along the frame's first axis u and the box of its
-// points across u.
+// A bounding hierarchy over a polygon's edges for the closest pair of two large windows of
+// polygons (separated_polygons.cpp), near or far apart: each node is a chain of consecutive edges
+// with, in each of a few orthonormal frames, the interval of its depths along the frame's first
+// axis u and the box of its points across u.
 //
 // The bound. Write a point's coordinates in a frame (u, e1, e2): depth z = u . p and the part
 // across, w = (e1 . p, e2 . p). For points p, q of two chains,
@@ -28,8 +28,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace diffpills::detail {
@@ -131,17 +134,29 @@ class DepthBoxTree {
   std::vector<ChainExtents> computed_;
 };
 
-// Calls pairs.visit(i, j) for every edge i of tree a's polygon and j of tree b's in a pair of
-// leaves whose bound is below pairs.limit(), the limit read again at each step so that a caller
-// lowering it as it finds closer pairs prunes more. Of the two halves of a split, the one with the
-// lower bound is searched first, so that the limit falls early.
+// Searches the two halves of a split in order of their bounds, the lower first, so that the
+// limit falls early: search(half, its bound) for each.
+template <class Chain, class BoundOf, class Search>
+void search_nearer_half_first(const std::array<Chain, 2>& halves, const BoundOf& bound_of,
+                              const Search& search) {
+  const double first = bound_of(halves[0]), second = bound_of(halves[1]);
+  if (second < first) {
+    search(halves[1], second);
+    search(halves[0], first);
+  } else {
+    search(halves[0], first);
+    search(halves[1], second);
+  }
+}
+
+// search_close_edge_pairs below, for two chains whose bound is known.
 template <class TreeA, class TreeB, class Pairs>
 void search_close_edge_pairs(TreeA& a, const typename TreeA::Chain& chain_a, TreeB& b,
-                             const typename TreeB::Chain& chain_b, Pairs& pairs) {
-  if (distance_bound(a.extents(chain_a), b.extents(chain_b)) >= pairs.limit()) return;
+                             const typename TreeB::Chain& chain_b, double bound, Pairs& pairs) {
+  if (bound >= pairs.limit()) return;
   if (chain_a.is_leaf() && chain_b.is_leaf()) {
     for (Eigen::Index i = chain_a.first; i < chain_a.end; ++i) {
-      for (Eigen::Index j = chain_b.first; j < chain_b.end; ++j) pairs.visit(i, j);
+      pairs.visit(i, chain_b.first, chain_b.end);
     }
     return;
   }
@@ -149,18 +164,29 @@ void search_close_edge_pairs(TreeA& a, const typename TreeA::Chain& chain_a, Tre
   const bool split_a = !chain_a.is_leaf() && (chain_b.is_leaf() || chain_a.end - chain_a.first >=
                                                                        chain_b.end - chain_b.first);
   if (split_a) {
-    const auto halves = chain_a.halves();
-    const bool swap = distance_bound(a.extents(halves[1]), b.extents(chain_b)) <
-                      distance_bound(a.extents(halves[0]), b.extents(chain_b));
-    search_close_edge_pairs(a, halves[swap ? 1 : 0], b, chain_b, pairs);
-    search_close_edge_pairs(a, halves[swap ? 0 : 1], b, chain_b, pairs);
+    search_nearer_half_first(
+        chain_a.halves(),
+        [&](const auto& half) { return distance_bound(a.extents(half), b.extents(chain_b)); },
+        [&](const auto& half, double half_bound) {
+          search_close_edge_pairs(a, half, b, chain_b, half_bound, pairs);
+        });
   } else {
-    const auto halves = chain_b.halves();
-    const bool swap = distance_bound(a.extents(chain_a), b.extents(halves[1])) <
-                      distance_bound(a.extents(chain_a), b.extents(halves[0]));
-    search_close_edge_pairs(a, chain_a, b, halves[swap ? 1 : 0], pairs);
-    search_close_edge_pairs(a, chain_a, b, halves[swap ? 0 : 1], pairs);
+    search_nearer_half_first(
+        chain_b.halves(),
+        [&](const auto& half) { return distance_bound(a.extents(chain_a), b.extents(half)); },
+        [&](const auto& half, double half_bound) {
+          search_close_edge_pairs(a, chain_a, b, half, half_bound, pairs);
+        });
   }
+}
+
+// Calls pairs.visit(i, first, end), for edge i of tree a's polygon against edges first .. end - 1
+// of tree b's, for every pair of leaves whose bound is below pairs.limit(), the limit read again at
+// each step so that a caller lowering it as it finds closer pairs prunes more.
+template <class TreeA, class TreeB, class Pairs>
+void search_close_edge_pairs(TreeA& a, TreeB& b, Pairs& pairs) {
+  search_close_edge_pairs(a, a.root(), b, b.root(),
+                          distance_bound(a.extents(a.root()), b.extents(b.root())), pairs);
 }
 
 }  // namespace diffpills::detail

@@ -112,7 +112,7 @@ bool add_arc(Window& window, const Arc& arc, Eigen::Index size) {
 // came out 9.43e-10 apart instead of 9.00e-10: the windows held B's vertex the rounding chose, not
 // its lowest). Each polygon's margin therefore adds 2 extent delta. Where that takes in both
 // polygons whole (faces facing each other closer than rounding can tell directions apart), both
-// windows become the whole polygons and the enumeration (its sweep) decides.
+// windows become the whole polygons and the enumeration (its search of large windows) decides.
 //
 // Supports are found by climbing from the previous ones along the boundary, so that an iteration
 // costs the windows' enumeration plus the support's movement, not the polygons' size; each

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <optional>
 #include <type_traits>
 #include <utility>
@@ -234,9 +233,9 @@ std::array<ClosestFeature, 2> sides(const Candidate& chosen, const Polygon& a, c
   return {edge_point(a, chosen.i, chosen.s), edge_point(b, chosen.j, chosen.t)};
 }
 
-// Above this many vertex pairs, windows of polygon_windows.hpp are swept instead of visited all:
-// see sweep_pairs.
-constexpr Eigen::Index kSweepLimit = Eigen::Index{32} * 32;
+// Above this many vertex pairs, windows of polygon_windows.hpp are searched instead of visited
+// all: see search_large_windows.
+constexpr Eigen::Index kSearchLimit = Eigen::Index{32} * 32;
 
 // The edge pair (edge i of A, B's edge `other` j) solved and offered; `reach` is the best point
 // candidate's distance plus `band`, updated on an improvement.
@@ -328,51 +327,45 @@ void visit_all_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
   }
 }
 
-// Sorts feature indices by key(j), increasing. The keys are computed once: a comparison that
-// computed both (a dot product each) made the sorts of two 10^5-gons ~20 ms.
-template <class Key>
-std::vector<Eigen::Index> sorted_by(std::vector<Eigen::Index> members, const Key& key) {
-  std::vector<std::pair<double, Eigen::Index>> keyed(members.size());
-  for (std::size_t k = 0; k < members.size(); ++k) keyed[k] = {key(members[k]), members[k]};
-  std::sort(keyed.begin(), keyed.end());  // equal keys in index order
-  for (std::size_t k = 0; k < members.size(); ++k) members[k] = keyed[k].second;
-  return members;
-}
-
-// Feature indices 0 .. count - 1 sorted by key(j).
-template <class Key>
-std::vector<Eigen::Index> sorted_by(Eigen::Index count, const Key& key) {
-  std::vector<Eigen::Index> all(static_cast<std::size_t>(count));
-  std::iota(all.begin(), all.end(), Eigen::Index{0});
-  return sorted_by(std::move(all), key);
-}
-
-// Polygons far apart compared to their size (a distance over 1,000 times their extents), and specks
-// (both within 1,000 intersection tolerances, 1e-9 of the scene). There every pair's distance is
-// the distance between the polygons plus small terms, and the bounds of the sweep below, along A's
-// plane and across it, rule few pairs out: two 8,000-gons 1e13 times their size apart took 2.6 s (a
-// hostile review). A sweep by depth along the line between the polygons, used here before, fixed
-// those but was blind to the offset across that line: over A's face (4,000-gons 1e4 apart, 0.5 to
-// the side, tilted 1e-10 rad: 123 ms, against 2.3 ms along the plane; a hostile review), and for
-// faces 1e6 to 1e8 apart, tilted 1e-8 to 1e-6 rad and a few sizes to the side (16,000-gons 1e7
-// apart, 1e-6 rad, 2.5 aside: 175 ms), both grew as k^2. Their pairs are searched in
-// depth_box_tree.hpp's hierarchies, whose bound holds a pair's depth and its offset across, in two
-// frames: A's normal, in which A's chains have no depth and B's only their tilt (the closest pairs
-// of faces over each other), and u, the unit direction between the polygons' boxes (those to the
-// side). Measured on seven poses of unit 32,000-gons (1e4 to 1e8 apart, 1e-10 to 1e-5 rad, 0.5 to
-// 10 aside), the worst visited 544,000 edge pairs with u alone, 224,000 with A's normal alone and
-// 51,000 with both. The band is 0 (a pair is solved only if it can be closer, not merely tie): ties
-// at the tolerance can span the whole polygons, and the choice among them moves the points by at
-// most the polygons' size, within 1e-9 of the scene.
+// Large windows (above kSearchLimit vertex pairs, polygon_windows.hpp's on many-sided polygons):
+// their point candidates are searched in depth_box_tree.hpp's hierarchies of their edge chains,
+// whose bound holds a pair's depth and its offset across, in two frames: A's normal, in which A's
+// chains have no depth and B's only their tilt (the closest pairs of faces over each other), and
+// u, the unit direction between the windows' boxes (those to the side, and those far apart).
+//
+// Why hierarchies. Two sweeps were used here before, each bounding a pair by one part of its
+// distance, and each left the pairs the other part decides in as ties, k^2 of them:
+//   - along A's plane (the order of B's edges along the direction they spread in, with the height
+//     every B edge keeps over A's plane): far apart, where every pair's distance is the distance V
+//     between the polygons plus small terms (two 8,000-gons 1e13 times their size apart: 2.6 s);
+//     and laid flat or coplanar, with the gap across the line between them (1000:1 ellipses, long
+//     sides facing 500 apart in their plane: 1.4-1.8 s at 64,000 vertices, growing as k^1.8; a
+//     hostile review);
+//   - by depth along the line between the polygons: over A's face (4,000-gons 1e4 apart, 0.5 to
+//     the side, tilted 1e-10 rad: 123 ms), and for faces 1e6 to 1e8 apart, tilted 1e-8 to 1e-6
+//     rad and a few sizes to the side (16,000-gons 1e7 apart, 1e-6 rad, 2.5 aside: 175 ms).
+// Measured on seven poses of unit 32,000-gons (1e4 to 1e8 apart, 1e-10 to 1e-5 rad, 0.5 to 10
+// aside), the worst visited 544,000 edge pairs with u alone, 224,000 with A's normal alone and
+// 51,000 with both.
+//
+// The band is 0: a point candidate is taken only if it is closer, never for a tie, so a pair
+// that can only tie need not be solved. The tie band matters for intervals, which only parallel
+// edges make; those are offer_parallel_edge_pairs'.
+//
 // Rounding: the depths are dot products with coordinates as large as the distance, so for polygons
 // below ~1e-15 of it every depth is the same number to a few ulps, and a computed distance may
 // exceed its bound by its own rounding: every pair would be solved (two 8,000-gons 1e30 times their
-// size apart: 0.92 s; helper-4). A pair whose bound is within `slack` (a few ulps of the
-// coordinates) of the best distance is a tie at rounding and is left out too.
+// size apart: 0.92 s; helper-4). For windows over 1,000 times their extents apart, and specks, a
+// pair whose bound is within `slack` (16 ulps of the coordinates, about the rounding of any
+// computed distance) of the best distance is a tie at rounding and is left out too. Nearer, the
+// slack is 0 and the search returns the least computed distance: where the distance is nearly
+// flat along the polygons (1000:1 ellipses 0.05 apart, turned 1e-8 rad about their long axis,
+// their lowest points varying by 5e-12 x^2 along it), a slack of 16 ulps moved the point by
+// sqrt(slack / 5e-12) = 0.04 along the flat, 6 times what the rounding of the heights does.
 template <class Polygon>
-void search_by_depth(const Polygon& a, const CarriedPolygon<Polygon>& W,
-                     const SmallBuffer<Segment>& b_edges, const Eigen::Vector3d& u, double slack,
-                     Best& best) {
+void search_point_candidates(const Polygon& a, const CarriedPolygon<Polygon>& W,
+                             const SmallBuffer<Segment>& b_edges, const Eigen::Vector3d& u,
+                             double slack, Best& best) {
   DepthFrames frames;
   frames[0] << 0, 0, 1, 1, 0, 0, 0, 1, 0;  // A's normal, then A's x and y
   const Eigen::Vector3d e1 = u.unitOrthogonal();
@@ -383,6 +376,9 @@ void search_by_depth(const Polygon& a, const CarriedPolygon<Polygon>& W,
   const auto b_vertex = [&W](Eigen::Index j) { return W[j]; };
   DepthBoxTree<decltype(a_vertex)> tree_a(a.size(), a_vertex, frames);
   DepthBoxTree<decltype(b_vertex)> tree_b(W.size(), b_vertex, frames);
+  // A's edges are formed as the search meets them, once per leaf pair: a window's worth formed in
+  // advance cost more in page faults than the search itself where it meets few (two 10^5-gons
+  // 1e-11 rad from parallel).
   struct Pairs {
     const Polygon& a;
     const SmallBuffer<Segment>& b_edges;
@@ -390,168 +386,102 @@ void search_by_depth(const Polygon& a, const CarriedPolygon<Polygon>& W,
     Best& best;
     double reach;
     double limit() const { return reach - slack; }
-    void visit(Eigen::Index i, Eigen::Index j) {
-      solve_edge_pair(a.edge(i), i, b_edges[j], j, 0.0, reach, best);
+    void visit(Eigen::Index i, Eigen::Index first, Eigen::Index end) {
+      const Segment edge = a.edge(i);
+      for (Eigen::Index j = first; j < end; ++j) {
+        solve_edge_pair(edge, i, b_edges[j], j, 0.0, reach, best);
+      }
     }
   } pairs{a, b_edges, slack, best, std::sqrt(best.point.distance2)};
-  search_close_edge_pairs(tree_a, tree_a.root(), tree_b, tree_b.root(), pairs);
+  search_close_edge_pairs(tree_a, tree_b, pairs);
 }
 
-// The direction along A's plane (z = 0 of A's frame) in which B's edge middles spread the most:
-// the principal axis of their 2 x 2 covariance, angle = atan2(2 sxy, sxx - syy) / 2. The sweep
-// below runs along it, so that the slab each A feature meets cuts an elongated polygon across
-// (two 40,000-gons 1,000 times longer in y than in x, facing each other 1e-11 rad from parallel,
-// swept along A's x: 1.2-1.6 s, every A edge met ~600 B edges; along their length 25 ms).
-Eigen::Vector2d spread_axis(const SmallBuffer<EdgeBound>& bounds) {
-  const Eigen::Index count = bounds.size();
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (Eigen::Index j = 0; j < count; ++j) mean += bounds[j].middle.head<2>() / count;
-  double sxx = 0.0, sxy = 0.0, syy = 0.0;
-  for (Eigen::Index j = 0; j < count; ++j) {
-    const Eigen::Vector2d v = bounds[j].middle.head<2>() - mean;
-    sxx += v.x() * v.x();
-    sxy += v.x() * v.y();
-    syy += v.y() * v.y();
-  }
-  const double angle = 0.5 * std::atan2(2.0 * sxy, sxx - syy);
-  return {std::cos(angle), std::sin(angle)};
+// An edge direction's angle in A's plane modulo a half turn, in [0, pi): parallel edges, of
+// either sense, have the same one.
+constexpr double kHalfTurn = EIGEN_PI;
+double half_turn_angle(const Eigen::Vector3d& direction) {
+  double angle = std::atan2(direction.y(), direction.x());
+  if (angle < 0.0) angle += kHalfTurn;
+  return angle >= kHalfTurn ? angle - kHalfTurn : angle;
 }
 
-// The same pairs for large windows, visited in order of B's coordinate along `axis` (in A's
-// plane, spread_axis) outward from each A feature's, and only while that gap, with the height every
-// B feature keeps above or below A's plane, does not rule the rest out: a pair's points are at
-// least sqrt(dx^2 + gap^2) apart. Nearly parallel faces facing each other bring thousands of
-// vertices into both windows, and the double loop was quadratic (a hostile review: two 10^5-gons
-// 1e-11 rad from parallel took 2.3 s); here each A feature meets the B features of a thin slab,
-// about h1 + h2 + sqrt(2 d band) wide for edges by the bound along the plane (EdgeBound; with the
-// 3-D spheres' bound alone, ~sqrt(2 (h1 + h2) d), and the sweep grew as k^1.3). The pairs left out
-// are those the double loop's bounds rule out too. Specks and far windows go to search_by_depth.
+// The interval candidates of large windows: the pairs of parallel edges (closest_segment_
+// parameters' test, |u x v| <= 1e-12) within the tie band of the best point. Edge i of A (in
+// A's plane, u = (ux, uy, 0)) and edge j of B (v) have
+//   |u x v|^2 = vz^2 + (ux vy - uy vx)^2,
+// so a parallel pair has |vz| <= 1e-12 (B's edge along A's plane) and the angles of u and of v's
+// part along the plane within asin(1e-12 / |v_xy|) of each other modulo a half turn. B's edges
+// with |vz| <= kParallel are sorted by that angle and each A edge takes those within kParallel of
+// its own: windows twice as wide as the test's (the directions' rounding and atan2's are a few
+// ulps), so that no parallel pair is missed; the solver decides each pair taken. A convex polygon's
+// edges turn monotonically, so each A edge meets a few B edges (one or two for regular polygons),
+// where the sweep that took every pair with a B edge along A's plane within the band met the whole
+// tie set (1000:1 ellipses 500 apart in their plane: ~400,000 pairs at 64,000 vertices, all ties).
 template <class Polygon>
-void sweep_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
-                 const SmallBuffer<Segment>& b_edges, const SmallBuffer<EdgeBound>& b_bounds,
-                 double tolerance, double tie_tolerance, Best& best) {
-  const Eigen::Index kb = W.size();
-  Eigen::AlignedBox2d box_a;
-  Eigen::AlignedBox3d box_b;
-  for (Eigen::Index i = 0; i < a.size(); ++i) box_a.extend(a.vertex(i));
-  for (Eigen::Index j = 0; j < kb; ++j) box_b.extend(W[j]);
-  const Eigen::Vector3d apart = box_b.center() - lift(box_a.center());
+void offer_parallel_edge_pairs(const Polygon& a, const CarriedPolygon<Polygon>& W,
+                               const SmallBuffer<Segment>& b_edges, double band, Best& best) {
+  constexpr double kParallel = 2e-12;
+  double reach = std::sqrt(best.point.distance2) + band;
+  // B's edges along A's plane, less those whose height over it is beyond the reach (their bound
+  // rules out every pair; nearly parallel faces keep a few).
+  std::vector<std::pair<double, Eigen::Index>> along_plane;
+  for (Eigen::Index j = 0; j < b_edges.size(); ++j) {
+    if (std::abs(b_edges[j].direction.z()) <= kParallel &&
+        edge_bound(b_edges[j], W.start(j).z(), W.end(j).z()).height < reach) {
+      along_plane.emplace_back(half_turn_angle(b_edges[j].direction), j);
+    }
+  }
+  if (along_plane.empty()) return;
+  std::sort(along_plane.begin(), along_plane.end());
+  const auto offer_between = [&](const Segment& edge, Eigen::Index i, const EdgeBound& a_bound,
+                                 double low, double high) {
+    auto it = std::lower_bound(along_plane.begin(), along_plane.end(),
+                               std::make_pair(low, Eigen::Index{-1}));
+    for (; it != along_plane.end() && it->first <= high; ++it) {
+      const Eigen::Index j = it->second;
+      const EdgeBound b_bound = edge_bound(b_edges[j], W.start(j).z(), W.end(j).z());
+      offer_edge_pair(edge, a_bound, i, b_edges[j], b_bound, j, band, reach, best);
+    }
+  };
+  for (Eigen::Index i = 0; i < a.size(); ++i) {
+    const Segment edge = a.edge(i);
+    const EdgeBound a_bound = edge_bound(edge, 0.0, 0.0);  // its height is not used
+    const double angle = half_turn_angle(edge.direction);
+    offer_between(edge, i, a_bound, angle - kParallel, angle + kParallel);
+    // The window wrapped around the half turn.
+    if (angle - kParallel < 0.0) {
+      offer_between(edge, i, a_bound, angle - kParallel + kHalfTurn, kHalfTurn);
+    }
+    if (angle + kParallel >= kHalfTurn) {
+      offer_between(edge, i, a_bound, 0.0, angle + kParallel - kHalfTurn);
+    }
+  }
+}
+
+// The candidates of large windows: every closer point, by the hierarchies, then every interval
+// within the band. Specks (both windows within 1,000 intersection tolerances, 1e-9 of the scene:
+// cores below 1e-100 of the frame's units keep its tolerances, pair_frame.hpp) get no band: ties
+// at the tolerance span them whole.
+template <class Polygon>
+void search_large_windows(const Polygon& a, const CarriedPolygon<Polygon>& W,
+                          const SmallBuffer<Segment>& b_edges, double tolerance,
+                          double tie_tolerance, Best& best) {
+  Eigen::AlignedBox3d box_a, box_b;
+  for (Eigen::Index i = 0; i < a.size(); ++i) box_a.extend(lift(a.vertex(i)));
+  for (Eigen::Index j = 0; j < W.size(); ++j) box_b.extend(W[j]);
+  const Eigen::Vector3d apart = box_b.center() - box_a.center();
   const double extents = box_a.diagonal().norm() + box_b.diagonal().norm();
+  // The direction between the boxes, normalized by its largest part first (stableNormalized), so
+  // that windows of specks far below the frame's units (1e-154 and less) still have a unit one.
+  // Boxes with the same centre (no direction between them) take A's normal.
+  const Eigen::Vector3d u =
+      apart == Eigen::Vector3d::Zero() ? Eigen::Vector3d::UnitZ() : apart.stableNormalized();
   const bool specks = extents <= 1e3 * tolerance;
-  // Far apart compared to their size (a distance over 1,000 times the windows' extents), or
-  // specks: search_by_depth.
-  const bool by_depth = apart.norm() > extents && (specks || apart.norm() > 1e3 * extents);
-  // Specks near each other (their radii make the scene, and they keep its tolerances: cores below
-  // 1e-100 of the frame's units, pair_frame.hpp): the sweeps below with the band 0 of
-  // search_by_depth, for the same reason.
-  const double band = specks ? 0.0 : tie_tolerance;
-  const Eigen::Vector2d axis = spread_axis(b_bounds);
-  const auto along = [&axis](const Eigen::Vector3d& point) { return axis.dot(point.head<2>()); };
-  // Visits the B features in `order` from the first at or after x outward both ways, while
-  // `going_on(dx)` holds.
-  const auto visit = [](const std::vector<Eigen::Index>& order, const auto& x_of, double x,
-                        const auto& going_on, const auto& offer) {
-    const auto size = static_cast<Eigen::Index>(order.size());
-    const auto first =
-        std::lower_bound(order.begin(), order.end(), x,
-                         [&](Eigen::Index j, double value) { return x_of(j) < value; });
-    const auto start = static_cast<Eigen::Index>(first - order.begin());
-    for (Eigen::Index k = start; k < size && going_on(x_of(order[k]) - x); ++k) offer(order[k]);
-    for (Eigen::Index k = start - 1; k >= 0 && going_on(x_of(order[k]) - x); --k) offer(order[k]);
-  };
-
-  // A window's chords (the sub-polygon's edges across its gaps) are long, and a bound with their
-  // length would sweep everything: they are visited apart, by every A edge; the rest are swept
-  // with the largest half-length among them.
-  double mean_half_length = 0.0;
-  for (Eigen::Index j = 0; j < kb; ++j) mean_half_length += b_bounds[j].half_length / kb;
-  const auto is_long = [&](Eigen::Index j) {
-    return b_bounds[j].half_length > 8.0 * mean_half_length;
-  };
-  // The edge pairs in two passes: those with a B edge parallel to A's plane (|sin| <= 1e-12,
-  // segment_segment.hpp's parallel test, which a direction rising more than that fails) within
-  // the tie band, the others without it. Only the parallel ones can make an interval, the one kind
-  // of candidate that a tie can choose (Best::choice: of points only the closest is taken). Swept
-  // all with the band, facing faces far apart had every pair visited: B 1e8 above A and tilted
-  // 1e-6 rad, over its face, has half its edges within the band (64 ulps of the distance) of its
-  // lowest vertex, and every one of them within the bound along the plane of every A edge (two
-  // unit 4,000-gons: 210 ms; now 1 ms). A pass leaves out the B edges whose height, a lower bound
-  // of their distance, is at least its reach when it starts.
-  const auto sweep_edges = [&](bool parallel_pass, double pass_band) {
-    const double start_reach = std::sqrt(best.point.distance2) + pass_band;
-    std::vector<Eigen::Index> long_edges, edges;
-    double middle_gap = std::numeric_limits<double>::infinity(), half_length = 0.0;
-    double height_gap = std::numeric_limits<double>::infinity();
-    for (Eigen::Index j = 0; j < kb; ++j) {
-      const bool parallel = std::abs(b_edges[j].direction.z()) <= 1e-12;
-      if (parallel != parallel_pass || b_bounds[j].height >= start_reach) continue;
-      if (is_long(j)) {
-        long_edges.push_back(j);
-      } else {
-        edges.push_back(j);
-        middle_gap = std::min(middle_gap, std::abs(b_bounds[j].middle.z()));
-        height_gap = std::min(height_gap, b_bounds[j].height);
-        half_length = std::max(half_length, b_bounds[j].half_length);
-      }
-    }
-    const auto middle_x = [&](Eigen::Index j) { return along(b_bounds[j].middle); };
-    const std::vector<Eigen::Index> sorted = sorted_by(std::move(edges), middle_x);
-    double reach = start_reach;
-    for (Eigen::Index i = 0; i < a.size(); ++i) {
-      const Segment edge = a.edge(i);
-      const EdgeBound a_bound = edge_bound(edge, 0.0, 0.0);  // its height is not used here
-      for (const Eigen::Index j : long_edges) {
-        offer_edge_pair(edge, a_bound, i, b_edges[j], b_bounds[j], j, pass_band, reach, best);
-      }
-      visit(
-          sorted, middle_x, along(a_bound.middle),
-          [&](double dx) {
-            // Both bounds of EdgeBound, with the least gap and the longest edge of the pass.
-            const double half_lengths = a_bound.half_length + half_length;
-            const double far = reach + half_lengths;
-            const double lateral = std::max(0.0, std::abs(dx) - half_lengths);
-            return dx * dx + middle_gap * middle_gap < far * far &&
-                   lateral * lateral + height_gap * height_gap < reach * reach;
-          },
-          [&](Eigen::Index j) {
-            offer_edge_pair(edge, a_bound, i, b_edges[j], b_bounds[j], j, pass_band, reach, best);
-          });
-    }
-  };
-
-  if (by_depth) {
-    const double slack = 16 * std::numeric_limits<double>::epsilon() * (apart.norm() + extents);
-    search_by_depth(a, W, b_edges, apart.normalized(), slack, best);
-    if (band > 0.0) sweep_edges(true, band);
-    return;
-  }
-
-  const auto vertex_x = [&](Eigen::Index j) { return along(W[j]); };
-  double vertex_gap = std::numeric_limits<double>::infinity();
-  for (Eigen::Index j = 0; j < kb; ++j) vertex_gap = std::min(vertex_gap, std::abs(W[j].z()));
-  const std::vector<Eigen::Index> vertices = sorted_by(kb, vertex_x);
-  // A first, cheap pass seeds the best distance: each A vertex against the B vertices next to it
-  // along the axis. Without it the first A vertices, far from B's window, each swept all of B.
-  for (Eigen::Index i = 0; i < a.size(); ++i) {
-    const Eigen::Vector3d vertex = lift(a.vertex(i));
-    int taken = 0;
-    visit(
-        vertices, vertex_x, along(vertex), [&](double) { return taken++ < 4; },
-        [&](Eigen::Index j) {
-          best.offer({(vertex - W[j]).squaredNorm(), Kind::kEdges, i, j, 1.0, 1.0}, false);
-        });
-  }
-  for (Eigen::Index i = 0; i < a.size(); ++i) {
-    const Eigen::Vector3d vertex = lift(a.vertex(i));
-    visit(
-        vertices, vertex_x, along(vertex),
-        [&](double dx) { return dx * dx + vertex_gap * vertex_gap < best.point.distance2; },
-        [&](Eigen::Index j) {
-          best.offer({(vertex - W[j]).squaredNorm(), Kind::kEdges, i, j, 1.0, 1.0}, false);
-        });
-  }
-  sweep_edges(false, 0.0);
-  sweep_edges(true, band);
+  const bool far = apart.norm() > 1e3 * extents;
+  const double slack =
+      specks || far ? 16 * std::numeric_limits<double>::epsilon() * (apart.norm() + extents) : 0.0;
+  search_point_candidates(a, W, b_edges, u, slack, best);
+  if (!specks) offer_parallel_edge_pairs(a, W, b_edges, tie_tolerance, best);
 }
 
 template <class Polygon>
@@ -572,8 +502,8 @@ std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
   }
   // Whole polygons (PolygonView) always get every pair: the fast path sends only small ones here,
   // and the tests compare the windows with this full enumeration.
-  if (std::is_same_v<Polygon, SubPolygon> && a.size() * kb > kSweepLimit) {
-    sweep_pairs(a, W, b_edges, edge_bounds(b_edges, W), tolerance, tie_tolerance, best);
+  if (std::is_same_v<Polygon, SubPolygon> && a.size() * kb > kSearchLimit) {
+    search_large_windows(a, W, b_edges, tolerance, tie_tolerance, best);
   } else {
     visit_all_pairs(a, W, X, b_edges, tolerance, tie_tolerance, best);
   }

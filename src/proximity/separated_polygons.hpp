@@ -55,11 +55,11 @@ class CarriedPolygon {
 // polygon_polygon.cpp): a support vertex of one over the other's face (or, for an edge parallel to
 // that face, the middle of its part over it), and every pair of edges (the middle of their overlap
 // when parallel), the pairs whose lower bound exceeds the best distance by the tie band skipped
-// (the tie tolerance; windows larger than 32 x 32 vertex pairs keep it only for pairs that can
-// make an interval, and those far apart, or specks, are searched in depth_box_tree.hpp's
-// hierarchies), up to
-// 32 x 32 vertex pairs with segment_bounds.hpp's vector bounds where the CPU has 4 lanes.
-// Candidates for a whole interval win ties within the tie tolerance (pair_frame.hpp).
+// (the tie tolerance), up to 32 x 32 vertex pairs with segment_bounds.hpp's vector bounds where
+// the CPU has 4 lanes. Windows larger than that are searched in depth_box_tree.hpp's hierarchies
+// for every closer pair, and their pairs of parallel edges, the only ones that make an interval,
+// are taken apart within the band. Candidates for a whole interval win ties within the tie
+// tolerance (pair_frame.hpp).
 std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const PolygonView& b,
                                                 const PolygonPairFrame& frame,
                                                 const CarriedPolygon<PolygonView>& W,
