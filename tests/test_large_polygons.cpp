@@ -85,6 +85,37 @@ BothPaths both_paths(const PaddedPolygon& a, const Pose& pa, const PaddedPolygon
   return out;
 }
 
+// A window holding every vertex of the polygon.
+detail::SubPolygon every_vertex(const detail::PolygonView& view) {
+  std::vector<Eigen::Index> indices(static_cast<std::size_t>(view.size()));
+  std::iota(indices.begin(), indices.end(), Eigen::Index{0});
+  return detail::SubPolygon(view, indices);
+}
+
+// The separated pair's enumeration of `first` against `second` on windows holding every vertex
+// (above 32 x 32 vertex pairs, the large windows' search), with both posed cores for world().
+struct WholeWindows {
+  detail::PosedCore core_1, core_2;
+  Sides sides;
+};
+
+WholeWindows search_whole_windows(const PaddedPolygon& first, const Pose& p1,
+                                  const PaddedPolygon& second, const Pose& p2, double tolerance,
+                                  double tie_tolerance) {
+  const detail::PolygonView view_1(first, 1.0), view_2(second, 1.0);
+  WholeWindows out{{p1.r(), detail::UnitQuaternion(p1.q()), 0.0, first.extent()},
+                   {p2.r(), detail::UnitQuaternion(p2.q()), 0.0, second.extent()},
+                   {}};
+  const detail::PolygonPairFrame frame(out.core_1, out.core_2);
+  const detail::SubPolygon all_1 = every_vertex(view_1), all_2 = every_vertex(view_2);
+  const detail::CarriedPolygon<detail::SubPolygon> all_W(all_2, frame.b_in_a, frame.b_origin_in_a);
+  const detail::CarriedPolygon<detail::SubPolygon> all_X(all_1, frame.b_in_a.transpose(),
+                                                         frame.a_origin_in_b);
+  out.sides =
+      detail::closest_separated(all_1, all_2, frame, all_W, all_X, tolerance, tie_tolerance);
+  return out;
+}
+
 Eigen::Vector3d world(const detail::PosedCore& core, const detail::ClosestFeature& side) {
   return core.r + core.attitude.matrix() * side.body_point;
 }
@@ -254,11 +285,6 @@ TEST(LargePolygons, TiesAndFacesMatchTheEnumeration) {
 TEST(LargePolygons, SpeckWindowsLeaveNoCloserPairOut) {
   Rng rng(41);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  const auto every_vertex = [](const detail::PolygonView& view) {
-    std::vector<Eigen::Index> indices(static_cast<std::size_t>(view.size()));
-    std::iota(indices.begin(), indices.end(), Eigen::Index{0});
-    return detail::SubPolygon(view, indices);
-  };
   for (int trial = 0; trial < 40; ++trial) {
     SCOPED_TRACE(::testing::Message() << "trial " << trial);
     const TestShape a = many_sided(rng, 100 + 10 * trial, trial % 5 == 0);
@@ -276,24 +302,18 @@ TEST(LargePolygons, SpeckWindowsLeaveNoCloserPairOut) {
       const PaddedPolygon& second = swapped ? polygon_a : polygon_b;
       const Pose& p1 = swapped ? pb : pa;
       const Pose& p2 = swapped ? pa : pb;
+      const WholeWindows whole = search_whole_windows(first, p1, second, p2, 1e3, 1e-13);
       const detail::PolygonView view_1(first, 1.0), view_2(second, 1.0);
-      const detail::PosedCore core_1{p1.r(), detail::UnitQuaternion(p1.q()), 0.0, first.extent()};
-      const detail::PosedCore core_2{p2.r(), detail::UnitQuaternion(p2.q()), 0.0, second.extent()};
-      const detail::PolygonPairFrame frame(core_1, core_2);
+      const detail::PolygonPairFrame frame(whole.core_1, whole.core_2);
       const detail::CarriedPolygon<detail::PolygonView> W(view_2, frame.b_in_a,
                                                           frame.b_origin_in_a);
-      const detail::SubPolygon all_1 = every_vertex(view_1), all_2 = every_vertex(view_2);
-      const detail::CarriedPolygon<detail::SubPolygon> all_W(all_2, frame.b_in_a,
-                                                             frame.b_origin_in_a);
-      const detail::CarriedPolygon<detail::SubPolygon> all_X(all_1, frame.b_in_a.transpose(),
-                                                             frame.a_origin_in_b);
-      const Sides swept = detail::closest_separated(all_1, all_2, frame, all_W, all_X, 1e3, 1e-13);
       const Sides windows =
           detail::closest_separated_by_windows(view_1, view_2, frame, W, 1e3, 1e-13);
-      for (const Sides& sides : {swept, windows}) {
-        const double distance = (world(core_1, sides[0]) - world(core_2, sides[1])).norm();
+      for (const Sides& sides : {whole.sides, windows}) {
+        const double distance =
+            (world(whole.core_1, sides[0]) - world(whole.core_2, sides[1])).norm();
         EXPECT_NEAR(distance, static_cast<double>(reference), 1e-12 * (1.0 + distance))
-            << (swapped ? "b, a" : "a, b") << (&sides == &swept ? ", swept" : ", windows");
+            << (swapped ? "b, a" : "a, b") << (&sides == &windows ? ", windows" : ", searched");
       }
     }
   }
@@ -335,11 +355,6 @@ PaddedPolygon half_ellipse(int count, double turn) {
 TEST(LargePolygons, LargeWindowsReturnTheMiddleOfParallelEdges) {
   Rng rng(43);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  const auto every_vertex = [](const detail::PolygonView& view) {
-    std::vector<Eigen::Index> indices(static_cast<std::size_t>(view.size()));
-    std::iota(indices.begin(), indices.end(), Eigen::Index{0});
-    return detail::SubPolygon(view, indices);
-  };
   const double gap = 0.3;
   for (int trial = 0; trial < 480; ++trial) {
     SCOPED_TRACE(::testing::Message() << "trial " << trial);
@@ -385,22 +400,13 @@ TEST(LargePolygons, LargeWindowsReturnTheMiddleOfParallelEdges) {
       const PaddedPolygon& second = swapped ? a : b;
       const Pose& p1 = swapped ? moved_b : moved_a;
       const Pose& p2 = swapped ? moved_a : moved_b;
-      const detail::PolygonView view_1(first, 1.0), view_2(second, 1.0);
-      const detail::PosedCore core_1{p1.r(), detail::UnitQuaternion(p1.q()), 0.0, first.extent()};
-      const detail::PosedCore core_2{p2.r(), detail::UnitQuaternion(p2.q()), 0.0, second.extent()};
       const detail::PairFrame scales =
           detail::make_pair_frame(first.extent(), 0.0, second.extent(), 0.0, p1.r(), p2.r());
-      const detail::PolygonPairFrame frame(core_1, core_2);
-      const detail::SubPolygon all_1 = every_vertex(view_1), all_2 = every_vertex(view_2);
-      const detail::CarriedPolygon<detail::SubPolygon> all_W(all_2, frame.b_in_a,
-                                                             frame.b_origin_in_a);
-      const detail::CarriedPolygon<detail::SubPolygon> all_X(all_1, frame.b_in_a.transpose(),
-                                                             frame.a_origin_in_b);
-      const Sides sides = detail::closest_separated(all_1, all_2, frame, all_W, all_X,
-                                                    scales.tolerance * scales.scale,
-                                                    scales.tie_tolerance * scales.scale);
-      EXPECT_LE((world(core_1, sides[0]) - expected[swapped ? 1 : 0]).norm(), 1e-9);
-      EXPECT_LE((world(core_2, sides[1]) - expected[swapped ? 0 : 1]).norm(), 1e-9);
+      const WholeWindows whole =
+          search_whole_windows(first, p1, second, p2, scales.tolerance * scales.scale,
+                               scales.tie_tolerance * scales.scale);
+      EXPECT_LE((world(whole.core_1, whole.sides[0]) - expected[swapped ? 1 : 0]).norm(), 1e-9);
+      EXPECT_LE((world(whole.core_2, whole.sides[1]) - expected[swapped ? 0 : 1]).norm(), 1e-9);
     }
   }
 }
