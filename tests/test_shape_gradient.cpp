@@ -283,6 +283,54 @@ TEST(ShapeGradient, RowsOfAnyScaleGetTheirGradient) {
   EXPECT_EQ(overflowing.d(0), -std::numeric_limits<double>::infinity());
 }
 
+// Rows with subnormal entries of many bits: the same polygon given with such a row rescaled to
+// unit length by 2^k has the same closest points, and the row's gradient is 2^-k times the
+// rescaled row's, exactly, or infinite where that exceeds the largest double. fuzz_proximity's
+// scene: a 4-row polygon (rows down to 6e-317 and 8e-321) 1e70 from a 51-gon. In the fuzzer's
+// build (clang) the multiplier of the row [-6.2e-317, -7.6e-321] was a rounding residue, 5e-66,
+// and its d-gradient, -7.6e250, was 1e-7 off 2^-k times the rescaled row's: |C_i| by hypot of the
+// row as given kept only the bits of a subnormal above 2^-1074. The residue depends on the
+// compiler's rounding (here the gradient overflows, as the rescaled row's scaled back does), so
+// that input is kept in fuzz_proximity's corpus, which make test replays under clang.
+TEST(ShapeGradient, SubnormalRowsScaleExactlyLikeTheirRowsRescaled) {
+  Eigen::MatrixX2d C(4, 2);
+  C << 0, 2.25, -6.2167845438435712e-317, -7.5888483201215469e-321, 5.5593629330205671e-83,
+      2.4677579418653533e-178, 3.3051431974266301e+40, -3.1280323686774314e-230;
+  const Eigen::Vector4d d(2.625, 4.7974170233113611e-299, 1e+100, 1.6525713069001583e+40);
+  const int sides = 51;
+  Eigen::MatrixX2d round(sides, 2);
+  for (int i = 0; i < sides; ++i) {
+    round.row(i) << std::cos(2 * M_PI * i / sides), std::sin(2 * M_PI * i / sides);
+  }
+  const PaddedPolygon b(round, Eigen::VectorXd::Constant(sides, 4.1410478080743383e+70),
+                        1.8807128734703512e-119);
+  const double big = 1.0352619520185846e+70;
+  const Pose pose_a(Eigen::Vector3d(4.1410478080743383e+70, big, big),
+                    Eigen::Vector4d(big, 3, big, -3));
+  const Pose pose_b(Eigen::Vector3d(-2.875, -2.5, 0.5), Eigen::Vector4d(0.5, 0.5, 0.5, 0.5));
+  Eigen::MatrixX2d unit_rows = C;
+  Eigen::Vector4d unit_offsets = d;
+  // Only the subnormal row is rescaled: the loose row's offset, 1e100, scaled alike would exceed
+  // the accepted magnitudes.
+  Eigen::Vector4i exponents = Eigen::Vector4i::Zero();
+  std::frexp(std::hypot(C(1, 0), C(1, 1)), &exponents(1));
+  unit_rows.row(1) << std::ldexp(C(1, 0), -exponents(1)), std::ldexp(C(1, 1), -exponents(1));
+  unit_offsets(1) = std::ldexp(d(1), -exponents(1));
+  const PaddedPolygon given(C, d, 0.0), rescaled(unit_rows, unit_offsets, 0.0);
+  const ProximityShapeGradient g = proximity_shape_gradient(given, pose_a, b, pose_b);
+  const ProximityShapeGradient u = proximity_shape_gradient(rescaled, pose_a, b, pose_b);
+  EXPECT_EQ(g.core_points, u.core_points);
+  const auto& given_rows = std::get<PolygonShapeGradient>(g.shape_gradient[0]);
+  const auto& unit = std::get<PolygonShapeGradient>(u.shape_gradient[0]);
+  ASSERT_TRUE(unit.d.allFinite() && unit.C.allFinite());
+  for (int i = 0; i < 4; ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(given_rows.d(i), std::ldexp(unit.d(i), -exponents(i)));
+    EXPECT_EQ(given_rows.C(i, 0), std::ldexp(unit.C(i, 0), -exponents(i)));
+    EXPECT_EQ(given_rows.C(i, 1), std::ldexp(unit.C(i, 1), -exponents(i)));
+  }
+}
+
 TEST(ShapeGradient, AnalyticCases) {
   Eigen::MatrixX2d C(5, 2);
   C << 1, 0, 0, 1, -1, 0, 0, -1, 2, 0;  // the last row is x <= 4: redundant, twice loose
