@@ -42,6 +42,7 @@
 
 #include "diffpills/shapes.hpp"
 #include "row_predicates.hpp"
+#include "row_scale.hpp"
 #include "validation.hpp"
 
 namespace diffpills {
@@ -153,25 +154,16 @@ bool vertices_of(const std::vector<UnitRow>& kept, Eigen::MatrixX2d& vertices, d
 }
 
 // The row C y <= d as n . y <= b with |n| = 1; false for a row that constrains nothing (C = 0, or
-// an offset beyond the largest double, a half-plane that holds every representable point).
-// The row is first scaled by a power of two to its largest entry in [1, 2), exactly, and n and b
-// are taken from that: a row and the same row times 2^k give the same n and b to the bit. Divided
-// by hypot(c0, c1) as given, a subnormal row's norm kept only the bits left above 2^-1074 (47 of
-// 53 for [-6e-317, -1e-309]), its normal differed from the rescaled row's in the last digits, and
-// so did the closest points (fuzz_proximity: the rows of a polygon rescaled to unit length, the
-// same polygon, gave other points).
+// an offset beyond the largest double, a half-plane that holds every representable point). n and
+// b are taken from the row scaled exactly by a power of two (row_scale.hpp): a row and the same
+// row times 2^k give the same n and b to the bit (a subnormal row's normal, by hypot of the row as
+// given, was ~1e-4 from unit, and the polygon off by as much; fuzz_proximity).
 bool normalize_row(double c0, double c1, double d, UnitRow& row) {
-  const double largest = std::max(std::abs(c0), std::abs(c1));
-  if (largest == 0.0) return false;
-  int exponent = 0;
-  std::frexp(largest, &exponent);  // largest = f 2^exponent, f in [1/2, 1)
-  // Each value times 2^(1 - exponent), not times that power formed first: for a subnormal row
-  // (largest below 2^-1022) the power is above 2^1023, infinite, and the row was dropped as
-  // constraining nothing (a hostile review: [1e-308, 0] y <= 5e-309 ignored, a point beyond it
-  // reported touching).
-  row.scaled_row = Eigen::Vector2d(std::ldexp(c0, 1 - exponent), std::ldexp(c1, 1 - exponent));
-  row.scaled_offset = std::ldexp(d, 1 - exponent);
-  const double norm = std::hypot(row.scaled_row.x(), row.scaled_row.y());  // in [1, 2 sqrt(2)]
+  if (c0 == 0.0 && c1 == 0.0) return false;
+  const int shift = detail::row_scale_shift(c0, c1);
+  row.scaled_row = detail::scaled_row(c0, c1, shift);
+  row.scaled_offset = std::ldexp(d, shift);
+  const double norm = detail::scaled_row_norm(row.scaled_row);
   row.normal = row.scaled_row / norm;
   row.offset = row.scaled_offset / norm;
   return std::isfinite(row.offset) && std::isfinite(row.scaled_offset);

@@ -1,10 +1,10 @@
 // Shape-parameter gradients by the envelope theorem (the derivation is in shape_gradient.hpp).
 #include "diffpills/shape_gradient.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 #include "diffpills/rotation.hpp"
+#include "row_scale.hpp"
 
 namespace diffpills {
 namespace {
@@ -47,22 +47,19 @@ PolygonShapeGradient polygon_gradient(const PaddedPolygon& polygon, const Pose& 
     const std::array<Eigen::Index, 2> edges = {j, (j + 1) % k};
     for (int side = 0; side < 2; ++side) {
       const int row = polygon.edge_rows()(edges[static_cast<std::size_t>(side)]);
-      // The multiplier of the row as given, mu / |C_i| = 2^(1 - e) mu / |C_i 2^(1 - e)|, with
-      // 2^e above the row's largest entry: the row scaled exactly to entries in [1, 2) (as the
-      // polygon normalizes its rows, padded_polygon.cpp), its norm by hypot, the power of two
-      // applied last. Not C.row(i).norm(), which squares (a row below ~1e-154 made it 0 and the
-      // gradient infinite or NaN: a hostile review), nor hypot of the row as given, which keeps
-      // only the bits of a subnormal norm above 2^-1074 (a row of 6e-317 had its gradient 1e-7
-      // off the rescaled row's; fuzz_proximity). An entry beyond the largest double is
-      // +-infinity (ldexp overflows), never 0 * inf.
+      // The multiplier of the row as given, mu / |C_i| = 2^s mu / |C_i 2^s|: the row scaled
+      // exactly (row_scale.hpp, as the polygon normalizes its rows), 2^s applied last. Not
+      // C.row(i).norm(), which squares (a row below ~1e-154 made it 0 and the gradient infinite
+      // or NaN: a hostile review), nor hypot of the row as given (a subnormal row of 6e-317 had
+      // its gradient 1e-7 off the rescaled row's; fuzz_proximity). An entry beyond the largest
+      // double is +-infinity (ldexp overflows), never 0 * inf.
       const double mu_side = mu[static_cast<std::size_t>(side)];
-      int exponent = 0;
-      std::frexp(std::max(std::abs(C(row, 0)), std::abs(C(row, 1))), &exponent);
+      const int shift = detail::row_scale_shift(C(row, 0), C(row, 1));
       const double scaled_norm =
-          std::hypot(std::ldexp(C(row, 0), 1 - exponent), std::ldexp(C(row, 1), 1 - exponent));
-      out.d(row) = std::ldexp(-mu_side / scaled_norm, 1 - exponent);
-      out.C(row, 0) = std::ldexp(mu_side * y.x() / scaled_norm, 1 - exponent);
-      out.C(row, 1) = std::ldexp(mu_side * y.y() / scaled_norm, 1 - exponent);
+          detail::scaled_row_norm(detail::scaled_row(C(row, 0), C(row, 1), shift));
+      out.d(row) = std::ldexp(-mu_side / scaled_norm, shift);
+      out.C(row, 0) = std::ldexp(mu_side * y.x() / scaled_norm, shift);
+      out.C(row, 1) = std::ldexp(mu_side * y.y() / scaled_norm, shift);
     }
     return out;
   }

@@ -423,24 +423,30 @@ void offer_parallel_edge_pairs(const Polygon& a, const CarriedPolygon<Polygon>& 
   constexpr double kParallel = 2e-12;
   double reach = std::sqrt(best.point.distance2) + band;
   // B's edges along A's plane, less those whose height over it is beyond the reach (their bound
-  // rules out every pair; nearly parallel faces keep a few).
-  std::vector<std::pair<double, Eigen::Index>> along_plane;
+  // rules out every pair; nearly parallel faces keep a few), by angle (then index).
+  struct AlongPlane {
+    double angle;
+    Eigen::Index j;
+    EdgeBound bound;
+  };
+  std::vector<AlongPlane> along_plane;
   for (Eigen::Index j = 0; j < b_edges.size(); ++j) {
-    if (std::abs(b_edges[j].direction.z()) <= kParallel &&
-        edge_bound(b_edges[j], W.start(j).z(), W.end(j).z()).height < reach) {
-      along_plane.emplace_back(half_turn_angle(b_edges[j].direction), j);
-    }
+    if (std::abs(b_edges[j].direction.z()) > kParallel) continue;
+    const EdgeBound bound = edge_bound(b_edges[j], W.start(j).z(), W.end(j).z());
+    if (bound.height < reach)
+      along_plane.push_back({half_turn_angle(b_edges[j].direction), j, bound});
   }
   if (along_plane.empty()) return;
-  std::sort(along_plane.begin(), along_plane.end());
+  const auto by_angle = [](const AlongPlane& x, const AlongPlane& y) {
+    return x.angle < y.angle || (x.angle == y.angle && x.j < y.j);
+  };
+  std::sort(along_plane.begin(), along_plane.end(), by_angle);
   const auto offer_between = [&](const Segment& edge, Eigen::Index i, const EdgeBound& a_bound,
                                  double low, double high) {
-    auto it = std::lower_bound(along_plane.begin(), along_plane.end(),
-                               std::make_pair(low, Eigen::Index{-1}));
-    for (; it != along_plane.end() && it->first <= high; ++it) {
-      const Eigen::Index j = it->second;
-      const EdgeBound b_bound = edge_bound(b_edges[j], W.start(j).z(), W.end(j).z());
-      offer_edge_pair(edge, a_bound, i, b_edges[j], b_bound, j, band, reach, best);
+    auto it = std::lower_bound(along_plane.begin(), along_plane.end(), low,
+                               [](const AlongPlane& x, double value) { return x.angle < value; });
+    for (; it != along_plane.end() && it->angle <= high; ++it) {
+      offer_edge_pair(edge, a_bound, i, b_edges[it->j], it->bound, it->j, band, reach, best);
     }
   };
   for (Eigen::Index i = 0; i < a.size(); ++i) {
