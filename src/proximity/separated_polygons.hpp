@@ -28,17 +28,29 @@ struct PolygonPairFrame {
 };
 
 // One polygon's vertices carried into the other's body frame, x -> rotation [x; 0] + translation.
+// Holds the polygon it was made from, which must outlive it.
 template <class Polygon>
 class CarriedPolygon {
  public:
   CarriedPolygon(const Polygon& polygon, const Eigen::Matrix3d& rotation,
                  const Eigen::Vector3d& translation)
-      : count_(polygon.size()), vertices_(count_) {
+      : polygon_(&polygon),
+        rise_(rotation.template block<1, 2>(2, 0)),
+        count_(polygon.size()),
+        vertices_(count_) {
     for (Eigen::Index i = 0; i < count_; ++i) {
       vertices_[i] = rotation.template leftCols<2>() * polygon.vertex(i) + translation;
     }
   }
   const Eigen::Vector3d& operator[](Eigen::Index i) const { return vertices_[i]; }
+  // Vertex i's height turned but not translated: [vertex i].z() less the translation's z, without
+  // the rounding of that sum. Heights of a polygon a distance h above the plane round to ulps of
+  // h, and for one tilted 1e-11 rad from the plane that is more than the rise of the vertices next
+  // to its lowest. The rises carry only the rounding of the rotation's row z, a few 1e-16 per unit
+  // of the polygon's size whatever h is.
+  double rise(Eigen::Index i) const { return rise_.dot(polygon_->vertex(i)); }
+  // How far edge j climbs from its start to its end, from the rises.
+  double climb(Eigen::Index j) const { return rise(j) - rise(j == 0 ? count_ - 1 : j - 1); }
   // Start and end of edge j (edge j runs from vertex j - 1 to vertex j).
   const Eigen::Vector3d& start(Eigen::Index j) const {
     return vertices_[j == 0 ? count_ - 1 : j - 1];
@@ -47,6 +59,8 @@ class CarriedPolygon {
   Eigen::Index size() const { return count_; }
 
  private:
+  const Polygon* polygon_;
+  Eigen::RowVector2d rise_;  // the rotation's row z in the polygon's plane
   Eigen::Index count_;
   SmallBuffer<Eigen::Vector3d> vertices_;
 };
