@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <tuple>
 #include <vector>
@@ -28,12 +29,10 @@ Vector14 swap_halves(const Vector14& g) {
   return out;
 }
 
+// The answer does not depend on the order of the shapes or on a rigid motion of the scene.
 template <class A, class B>
-void expect_middle(const A& a, const Pose& pa, const B& b, const Pose& pb,
-                   const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double size = 1.0) {
+void expect_invariant(const A& a, const Pose& pa, const B& b, const Pose& pb, double size = 1.0) {
   const ProximityJacobian r = proximity_jacobian(a, pa, b, pb);
-  EXPECT_LE((r.core_points[0] - p1).norm(), 1e-12 * size) << r.core_points[0].transpose();
-  EXPECT_LE((r.core_points[1] - p2).norm(), 1e-12 * size) << r.core_points[1].transpose();
   ASSERT_TRUE(r.gradient.allFinite() && r.points_jacobian.allFinite());
 
   const ProximityJacobian swapped = proximity_jacobian(b, pb, a, pa);
@@ -68,6 +67,16 @@ void expect_middle(const A& a, const Pose& pa, const B& b, const Pose& pb,
       }
     }
   }
+}
+
+// The answer is the given pair (the middle of the optimal set) and is invariant.
+template <class A, class B>
+void expect_middle(const A& a, const Pose& pa, const B& b, const Pose& pb,
+                   const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double size = 1.0) {
+  const ProximityJacobian r = proximity_jacobian(a, pa, b, pb);
+  EXPECT_LE((r.core_points[0] - p1).norm(), 1e-12 * size) << r.core_points[0].transpose();
+  EXPECT_LE((r.core_points[1] - p2).norm(), 1e-12 * size) << r.core_points[1].transpose();
+  expect_invariant(a, pa, b, pb, size);
 }
 
 const Eigen::Vector4d kQuarterX = about(M_PI / 2, 1, 0, 0);  // the body x-y plane to x-z
@@ -196,6 +205,20 @@ TEST(OptimalSet, OctagonTiltedAboutItsEdgeAFewPicoradians) {
   expect_middle(floor, Pose(), octagon, turned, {middle.x(), middle.y(), 0}, middle);
 }
 
+// The polygon through `vertices`, counterclockwise, with no padding.
+PaddedPolygon polygon_through(const std::vector<Eigen::Vector2d>& vertices) {
+  const auto count = static_cast<Eigen::Index>(vertices.size());
+  Eigen::MatrixX2d C(count, 2);
+  Eigen::VectorXd d(count);
+  for (Eigen::Index i = 0; i < count; ++i) {
+    const Eigen::Vector2d& start = vertices[static_cast<std::size_t>(i)];
+    const Eigen::Vector2d edge = vertices[static_cast<std::size_t>((i + 1) % count)] - start;
+    C.row(i) = Eigen::Vector2d(edge.y(), -edge.x()).normalized().transpose();
+    d(i) = C.row(i).dot(start);
+  }
+  return PaddedPolygon(C, d, 0.0);
+}
+
 // A rounded rectangle (half-sides 1 and 0.5, corners of radius 0.2 drawn with 200 edges each)
 // 1 above a large square, turned 1e-11 .. 2e-10 rad about its lower straight edge: that edge is
 // the optimal set. The corners' first vertices rise from it by 3e-17 .. 6e-16, below the ulp of
@@ -205,8 +228,8 @@ TEST(OptimalSet, OctagonTiltedAboutItsEdgeAFewPicoradians) {
 // without the translation (CarriedPolygon::rise).
 TEST(OptimalSet, RoundedRectangleTurnedAboutItsLowerEdgeAFewPicoradians) {
   const int per_corner = 200;
-  std::vector<Eigen::Vector2d> vertices;
   const double hx = 1.0, hy = 0.5, corner = 0.2;
+  std::vector<Eigen::Vector2d> vertices;
   for (int k = 0; k < 4; ++k) {
     const Eigen::Vector2d centre((k == 0 || k == 3 ? 1 : -1) * (hx - corner),
                                  (k < 2 ? 1 : -1) * (hy - corner));
@@ -215,16 +238,7 @@ TEST(OptimalSet, RoundedRectangleTurnedAboutItsLowerEdgeAFewPicoradians) {
       vertices.push_back(centre + corner * Eigen::Vector2d(std::cos(angle), std::sin(angle)));
     }
   }
-  const auto count = static_cast<Eigen::Index>(vertices.size());
-  Eigen::MatrixX2d C(count, 2);
-  Eigen::VectorXd d(count);
-  for (Eigen::Index i = 0; i < count; ++i) {
-    const Eigen::Vector2d edge =
-        vertices[static_cast<std::size_t>((i + 1) % count)] - vertices[static_cast<std::size_t>(i)];
-    C.row(i) = Eigen::Vector2d(edge.y(), -edge.x()).normalized().transpose();
-    d(i) = C.row(i).dot(vertices[static_cast<std::size_t>(i)]);
-  }
-  const PaddedPolygon plate(C, d, 0.0);
+  const PaddedPolygon plate = polygon_through(vertices);
   const PaddedPolygon floor = square(8.0, 0.0);
   for (const double tilt : {1e-11, 3e-11, 1e-10, 1.8e-10}) {
     SCOPED_TRACE(tilt);
@@ -234,6 +248,56 @@ TEST(OptimalSet, RoundedRectangleTurnedAboutItsLowerEdgeAFewPicoradians) {
         centre + Eigen::Vector3d(0, -hy * std::cos(tilt), -hy * std::sin(tilt));
     expect_middle(floor, Pose(), plate, turned, {middle.x(), middle.y(), 0}, middle);
   }
+}
+
+// A unit regular 64-gon 1e8 (1e9) above a square of half side 3, tilted 64 ulps of its height
+// per unit of its size (past the level faces laid flat): its lowest vertex and the point under it
+// are the closest pair, and vertex-edge pairs up to sqrt(2 h ulp(h)) ~ 1.7 along the square tie
+// with it within rounding. The vertex over the face wins those ties; with whichever pair rounding
+// made nearest, the square's point moved by 2 under rigid motions (a hostile review).
+TEST(OptimalSet, FarPolygonsJustPastLevelKeepTheVertexOverTheFace) {
+  std::vector<Eigen::Vector2d> vertices;
+  for (int k = 0; k < 64; ++k) {
+    const double angle = 2 * M_PI * k / 64 + 0.1;
+    vertices.emplace_back(std::cos(angle), std::sin(angle));
+  }
+  const PaddedPolygon plate = polygon_through(vertices);
+  const PaddedPolygon floor = square(3.0, 0.0);
+  for (const double height : {1e8, 1e9}) {
+    SCOPED_TRACE(height);
+    const double tilt = 64 * (std::nextafter(height, 2 * height) - height);
+    const Pose turned({0.2, -0.1, height}, about(tilt, std::cos(1.0), std::sin(1.0), 0));
+    // The lowest vertex by its rise, R v . e_z: its height R v . e_z + 1e8 would round to ulps
+    // of 1e8, more than the rise between neighbouring vertices.
+    const Eigen::Matrix3d R = rotation_matrix(turned.q());
+    Eigen::Vector3d lowest = Eigen::Vector3d::Zero();
+    double lowest_rise = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector2d& v : vertices) {
+      const Eigen::Vector3d turned_vertex = R * Eigen::Vector3d(v.x(), v.y(), 0);
+      if (turned_vertex.z() < lowest_rise) {
+        lowest_rise = turned_vertex.z();
+        lowest = turned_vertex + turned.r();
+      }
+    }
+    expect_middle(floor, Pose(), plate, turned, {lowest.x(), lowest.y(), 0}, lowest, height);
+  }
+}
+
+// A sliver (a triangle 3.3 long, 2.5e-6 wide at its base) touching a triangle within the
+// intersection tolerance, 5e-13 below its plane and tilted 1.8e-8 rad from it: a vertex over the
+// face and pairs that touch tie. When a vertex within the tolerance of the plane won such ties as
+// a proven closest point (a first version of Best::offer_over_face), the answer moved by 0.17
+// under one rigid motion in three (the review's fuzzing of that version).
+TEST(OptimalSet, SliverTouchingATriangleWithinTheTolerance) {
+  const PaddedPolygon triangle = polygon_through({{0.14051417597442192, -0.7228237289940014},
+                                                  {0.5557266237797924, 0.483100710482687},
+                                                  {-0.6962407997542144, 0.23972301851131433}});
+  const PaddedPolygon sliver = polygon_through({{-1.6438782122044353, 0.0},
+                                                {0.8219391061022177, -1.2329086591533264e-06},
+                                                {0.8219391061022177, 1.2329086591533264e-06}});
+  const Pose posed({-8.2505777751815312e-01, -1.5942865858112212e-01, -5.1447724382555361e-13},
+                   Eigen::Vector4d(1.0, 8.8067617893297068e-09, 4.4033808946648525e-15, 0.0));
+  expect_invariant(triangle, Pose(), sliver, posed);
 }
 
 // A box face (a square in a vertical plane) standing on a table: its bottom edge x in [-0.4, 0.6]

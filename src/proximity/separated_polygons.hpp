@@ -73,7 +73,8 @@ class CarriedPolygon {
 // the CPU has 4 lanes. Windows larger than that are searched in depth_box_tree.hpp's hierarchies
 // for every closer pair, and their pairs of parallel edges, the only ones that make an interval,
 // are taken apart within the band. Candidates for a whole interval win ties within the tie
-// tolerance (pair_frame.hpp).
+// tolerance (pair_frame.hpp), and a vertex over the other's face, its polygon clear of that plane,
+// wins them against other pairs (it is a closest point; what ties with it does by rounding).
 std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const PolygonView& b,
                                                 const PolygonPairFrame& frame,
                                                 const CarriedPolygon<PolygonView>& W,
