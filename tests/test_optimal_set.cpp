@@ -235,7 +235,7 @@ TEST(OptimalSet, RoundedRectangleTurnedAboutItsLowerEdgeAFewPicoradians) {
                                  (k < 2 ? 1 : -1) * (hy - corner));
     for (int i = 0; i <= per_corner; ++i) {
       const double angle = (k + static_cast<double>(i) / per_corner) * M_PI / 2;
-      vertices.push_back(centre + corner * Eigen::Vector2d(std::cos(angle), std::sin(angle)));
+      vertices.emplace_back(centre + corner * Eigen::Vector2d(std::cos(angle), std::sin(angle)));
     }
   }
   const PaddedPolygon plate = polygon_through(vertices);
