@@ -88,14 +88,14 @@ struct Candidate {
 // with vertex-edge pairs up to sqrt(2 d ulp(d)) ~ 1.7 along the square, whichever rounding made
 // nearest, and the square's point moved by 2 under rigid motions of the scene (a hostile review).
 struct Best {
-  Candidate point, interval, over_face;
+  Candidate point, interval, vertex_over_face;
   void offer(const Candidate& candidate, bool is_interval) {
     Candidate& kept = is_interval ? interval : point;
     if (candidate.distance2 < kept.distance2) kept = candidate;
   }
-  void offer_over_face(const Candidate& candidate) {
+  void offer_vertex_over_face(const Candidate& candidate) {
     offer(candidate, false);
-    if (candidate.distance2 < over_face.distance2) over_face = candidate;
+    if (candidate.distance2 < vertex_over_face.distance2) vertex_over_face = candidate;
   }
   // The interval wins if it is as close as the point, and a tie within the tie tolerance tau (see
   // fast_paths.hpp) if the point's pair is one of the interval's: each of its two points within
@@ -110,13 +110,14 @@ struct Best {
   const Candidate& choice(double tolerance, double tie_tolerance, const SidesOf& sides_of) const {
     if (interval.distance2 <= point.distance2) return interval;
     const double reach = std::sqrt(point.distance2) + tie_tolerance;
-    const Candidate& nearest = over_face.distance2 <= reach * reach ? over_face : point;
-    if (interval.distance2 > reach * reach) return nearest;
-    const std::array<ClosestFeature, 2> p = sides_of(nearest), i = sides_of(interval);
+    const Candidate& chosen_point =
+        vertex_over_face.distance2 <= reach * reach ? vertex_over_face : point;
+    if (interval.distance2 > reach * reach) return chosen_point;
+    const std::array<ClosestFeature, 2> p = sides_of(chosen_point), i = sides_of(interval);
     const double slack = tolerance + std::sqrt(2.0 * std::sqrt(point.distance2) * tie_tolerance);
     const bool on_a = (p[0].body_point - i[0].body_point).norm() <= interval.half_width_a + slack;
     const bool on_b = (p[1].body_point - i[1].body_point).norm() <= interval.half_width_b + slack;
-    return on_a && on_b ? interval : nearest;
+    return on_a && on_b ? interval : chosen_point;
   }
 };
 
@@ -167,16 +168,16 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
   const auto offer_support = [&](Eigen::Index support) {
     const Eigen::Vector3d& vertex = polygon[support];
     if (contains(over, vertex.head<2>(), 0.0)) {
-      const Candidate over =
+      const Candidate over_face =
           candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z(), 0.0, 0.0);
       // A vertex within the intersection tolerance of the plane proves nothing beyond it (its
       // polygon may cross the plane by as much, and a pair that touches is as good): a sliver
       // touching a triangle had its vertex win under some rigid motions and a touching edge
       // pair under others, 0.17 apart (a hostile review's fuzzing).
       if (std::abs(vertex.z()) > tolerance) {
-        best.offer_over_face(over);
+        best.offer_vertex_over_face(over_face);
       } else {
-        best.offer(over, false);
+        best.offer(over_face, false);
       }
     }
     // The two edges at the support vertex, each an interval of closest points if parallel to the
