@@ -283,6 +283,40 @@ TEST(OptimalSet, FarPolygonsJustPastLevelKeepTheVertexOverTheFace) {
   }
 }
 
+// The same 64-gon 1e8 (1e9) above the square, its lowest vertex within 1e-10 of the square's edge
+// x = 3, inside, on it or outside: whether the vertex is over the face was decided by the rounding
+// of its carried coordinates (ulps of the height, ~1.5e-8), and when it came out just off the
+// face, vertex-edge pairs up to ~1.4 along the rim tied with the vertex-edge pair below it and the
+// square's point moved by 1.4 under rigid motions (a hostile review). Within the intersection
+// tolerance of the face the vertex counts as over it, as a point that close to a polygon's
+// boundary is on it elsewhere.
+TEST(OptimalSet, FarPolygonWithItsLowestVertexOnTheRim) {
+  std::vector<Eigen::Vector2d> vertices;
+  for (int k = 0; k < 64; ++k) {
+    const double angle = 2 * M_PI * k / 64 + 0.1;
+    vertices.emplace_back(std::cos(angle), std::sin(angle));
+  }
+  const PaddedPolygon plate = polygon_through(vertices);
+  const PaddedPolygon floor = square(3.0, 0.0);
+  for (const double height : {1e8, 1e9}) {
+    for (const double beyond : {-1e-10, 0.0, 1e-10}) {
+      SCOPED_TRACE(::testing::Message() << height << " " << beyond);
+      const double tilt = 512 * (std::nextafter(height, 2 * height) - height);
+      const Eigen::Vector4d q = about(tilt, std::cos(0.3), std::sin(0.3), 0);
+      const Eigen::Matrix3d R = rotation_matrix(q);
+      Eigen::Vector3d lowest = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+      for (const Eigen::Vector2d& v : vertices) {
+        const Eigen::Vector3d turned_vertex = R * Eigen::Vector3d(v.x(), v.y(), 0);
+        if (turned_vertex.z() < lowest.z()) lowest = turned_vertex;
+      }
+      const Pose turned(Eigen::Vector3d(3.0 + beyond, -0.7, height) - lowest, q);
+      const Eigen::Vector3d vertex = lowest + turned.r();  // (3 + beyond, -0.7, height), rounded
+      expect_middle(floor, Pose(), plate, turned, {std::min(3.0, vertex.x()), vertex.y(), 0},
+                    vertex, height);
+    }
+  }
+}
+
 // A sliver (a triangle 3.3 long, 2.5e-6 wide at its base) touching a triangle within the
 // intersection tolerance, 5e-13 below its plane and tilted 1.8e-8 rad from it: a vertex over the
 // face and pairs that touch tie. When a vertex within the tolerance of the plane won such ties as

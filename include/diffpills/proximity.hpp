@@ -40,7 +40,11 @@
 //     that of the cores' own, the larger core and the distance between the body origins.)
 //     Shapes far apart compared to their size (a distance V, sizes h) have their closest points
 //     to within the scene's rounding only: beyond V ~ 1e6 h neighbouring candidates' distances
-//     differ by less than the tie tolerance. Two polygons apart whose heights over each other's
+//     differ by less than the tie tolerance. Among such ties a polygon's vertex over the other's
+//     face, the vertex of its polygon nearest that face's plane, is kept: no pair is nearer. It
+//     counts as over the face up to the smaller of the intersection and tie tolerances beyond
+//     the face's boundary, which the rounding of its coordinates cannot decide (the face's point
+//     then lies at most that far outside). Two polygons apart whose heights over each other's
 //     planes vary by less than the rounding of their coordinates (64 ulps of V plus their sizes,
 //     and at most the tie tolerance: unit polygons 1e8 apart and up to ~5e-7 rad from parallel)
 //     are level faces: every pair of features ties, and they are solved as parallel faces across

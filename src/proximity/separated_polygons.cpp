@@ -139,7 +139,7 @@ struct Best {
 // both its lowest and its highest vertex.
 template <class Polygon, class Over>
 void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, bool polygon_is_b,
-                     double tolerance, Best& best) {
+                     double tolerance, double tie_tolerance, Best& best) {
   // The extreme vertices by their rises (CarriedPolygon::rise), not by their heights: a rounded
   // rectangle 1 above the face and turned 1e-11 rad from it about its lower straight edge has its
   // corner's first vertices within an ulp of that edge in height (a rise of 3e-17 over 1), and
@@ -167,7 +167,19 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
   };
   const auto offer_support = [&](Eigen::Index support) {
     const Eigen::Vector3d& vertex = polygon[support];
-    if (contains(over, vertex.head<2>(), 0.0)) {
+    // Over the face grown by the smaller of the two tolerances: the vertex's carried coordinates
+    // round to ulps of the scene, and a polygon 1e8 above the face with its lowest vertex 1e-10
+    // from the face's edge was over it or not by rounding. When not, vertex-edge pairs up to ~1.4
+    // along the rim tied with the one below the vertex, and the face's point moved by 1.4 under
+    // rigid motions of the scene (a hostile review). Both tolerances are far above that rounding
+    // (64 ulps of the scene and more). Within the intersection tolerance a point is on the
+    // boundary, as elsewhere, and the face point reported lies at most that far outside it; within
+    // the tie tolerance the height, which the vertex's true distance exceeds by less than the
+    // slack, is a tie with it. (The intersection tolerance alone is too coarse where it exceeds
+    // the polygons' size, as in windows searched as specks: test_large_polygons searches unit
+    // polygons with a tolerance of 1,000, and a vertex 2.3 off the face counted as over it, its
+    // distance 0.79 for 2.4.)
+    if (contains(over, vertex.head<2>(), std::min(tolerance, tie_tolerance))) {
       const Candidate over_face =
           candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z(), 0.0, 0.0);
       // A vertex within the intersection tolerance of the plane proves nothing beyond it (its
@@ -529,8 +541,8 @@ std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
                                         double tie_tolerance) {
   const Eigen::Index kb = b.size();
   Best best;
-  offer_over_face(W, a, true, tolerance, best);
-  offer_over_face(X, b, false, tolerance, best);
+  offer_over_face(W, a, true, tolerance, tie_tolerance, best);
+  offer_over_face(X, b, false, tolerance, tie_tolerance, best);
   // B's edges in A's frame.
   SmallBuffer<Segment> b_edges(kb);
   for (Eigen::Index j = 0; j < kb; ++j) {
@@ -570,7 +582,7 @@ bool closest_over_face(const PolygonView& face, const SubPolygon& other,
                        const CarriedPolygon<SubPolygon>& carried, bool face_is_a, double tolerance,
                        double tie_tolerance, std::array<ClosestFeature, 2>& out) {
   Best best;
-  offer_over_face(carried, face, face_is_a, tolerance, best);
+  offer_over_face(carried, face, face_is_a, tolerance, tie_tolerance, best);
   const auto sides_of = [&](const Candidate& c) {
     return over_face_sides(c, other, carried, face_is_a);
   };
