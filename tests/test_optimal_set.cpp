@@ -287,9 +287,8 @@ TEST(OptimalSet, FarPolygonsJustPastLevelKeepTheVertexOverTheFace) {
 // x = 3, inside, on it or outside: whether the vertex is over the face was decided by the rounding
 // of its carried coordinates (ulps of the height, ~1.5e-8), and when it came out just off the
 // face, vertex-edge pairs up to ~1.4 along the rim tied with the vertex-edge pair below it and the
-// square's point moved by 1.4 under rigid motions (a hostile review). Within the intersection
-// tolerance of the face the vertex counts as over it, as a point that close to a polygon's
-// boundary is on it elsewhere.
+// square's point moved by 1.4 under rigid motions (a hostile review). Off the face by no more than
+// its rounding, the vertex is kept in its pair with the edge, as over the face it is kept alone.
 TEST(OptimalSet, FarPolygonWithItsLowestVertexOnTheRim) {
   std::vector<Eigen::Vector2d> vertices;
   for (int k = 0; k < 64; ++k) {
@@ -313,6 +312,46 @@ TEST(OptimalSet, FarPolygonWithItsLowestVertexOnTheRim) {
       const Eigen::Vector3d vertex = lowest + turned.r();  // (3 + beyond, -0.7, height), rounded
       expect_middle(floor, Pose(), plate, turned, {std::min(3.0, vertex.x()), vertex.y(), 0},
                     vertex, height);
+    }
+  }
+}
+
+// Near contact the rim's slack above must stay at rounding. A 7-gon's lowest vertex 4e-12 beyond
+// the square's edge x = 3 (about the intersection tolerance, 1e-12 of the scene of ~4.2) and 8e-12
+// or 3e-12 above its plane: the closest pair is off the face, 9e-12 and 4.7e-12 apart, its normal
+// 26 and 32 degrees from the face's. A version that counted the vertex over the face within the
+// intersection tolerance gave the face's normal, and at the lower height reported the cores
+// intersecting (a hostile review). Against the brute force of tests/support/reference.hpp.
+TEST(OptimalSet, LowestVertexJustBeyondTheRimNearContact) {
+  std::vector<Eigen::Vector2d> vertices;
+  std::vector<Eigen::Vector3d> body_vertices;
+  for (int k = 0; k < 7; ++k) {
+    const double angle = 2 * M_PI * k / 7 + 0.3;
+    vertices.emplace_back(std::cos(angle), std::sin(angle));
+    body_vertices.emplace_back(std::cos(angle), std::sin(angle), 0.0);
+  }
+  const PaddedPolygon heptagon = polygon_through(vertices);
+  const PaddedPolygon floor = square(3.0, 0.0);
+  const WorldCore floor_world{{{3, 3, 0}, {-3, 3, 0}, {-3, -3, 0}, {3, -3, 0}}};
+  const Eigen::Vector4d q = about(1.4, 0.6, 0.8, 0.0);
+  const Eigen::Matrix3d R = rotation_matrix(q);
+  Eigen::Vector3d lowest = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  for (const Eigen::Vector3d& v : body_vertices) {
+    if ((R * v).z() < lowest.z()) lowest = R * v;
+  }
+  for (const double height : {8e-12, 3e-12}) {
+    SCOPED_TRACE(height);
+    const Pose posed(Eigen::Vector3d(3.0 + 4e-12, 0.4, height) - lowest, q);
+    const ClosestPair exact =
+        brute_force_closest(floor_world, to_world({heptagon, body_vertices, 1.0}, posed));
+    const Vec3L exact_normal = (exact.p2 - exact.p1) / exact.distance;
+    for (const bool swap : {false, true}) {
+      const Proximity p = swap ? proximity(heptagon, posed, floor, Pose())
+                               : proximity(floor, Pose(), heptagon, posed);
+      EXPECT_FALSE(p.cores_intersect);
+      EXPECT_LE(((swap ? -1.0 : 1.0) * p.normal - exact_normal.cast<double>()).norm(), 1e-3)
+          << p.normal.transpose();
+      EXPECT_NEAR(std::sqrt(std::max(0.0, p.phi)), static_cast<double>(exact.distance), 2e-15);
     }
   }
 }

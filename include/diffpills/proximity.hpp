@@ -41,15 +41,16 @@
 //     Shapes far apart compared to their size (a distance V, sizes h) have their closest points
 //     to within the scene's rounding only: beyond V ~ 1e6 h neighbouring candidates' distances
 //     differ by less than the tie tolerance. Among such ties a polygon's vertex over the other's
-//     face, the vertex of its polygon nearest that face's plane, is kept: no pair is nearer. It
-//     counts as over the face up to the smaller of the intersection and tie tolerances beyond
-//     the face's boundary, which the rounding of its coordinates cannot decide (the face's point
-//     then lies at most that far outside). Two polygons apart whose heights over each other's
-//     planes vary by less than the rounding of their coordinates (64 ulps of V plus their sizes,
-//     and at most the tie tolerance: unit polygons 1e8 apart and up to ~5e-7 rad from parallel)
-//     are level faces: every pair of features ties, and they are solved as parallel faces across
-//     their mean normal, the centre of the overlap of their shadows along it (or the middle of the
-//     shadows' closest set), each polygon's point over it, the same in both orders.
+//     face, the vertex of its polygon nearest that face's plane, is kept: no pair is nearer. One
+//     off the face by no more than 16 ulps of its coordinates' magnitude in the pair's frame
+//     (their rounding cannot tell whether it is over the face) is kept in its pair with the
+//     face's nearest boundary point, at that pair's true distance. Two polygons apart whose
+//     heights over each other's planes vary by less than the rounding of their coordinates (here
+//     64 ulps of V plus their sizes, and at most the tie tolerance: unit polygons 1e8 apart and up
+//     to ~5e-7 rad from parallel) are level faces: every pair of features ties, and they are
+//     solved as parallel faces across their mean normal, the centre of the overlap of their
+//     shadows along it (or the middle of the shadows' closest set), each polygon's point over it,
+//     the same in both orders.
 //   - Two polygons are solved with the same one in the role of the first in both orders of the
 //     arguments (chosen by the polygons' own data, the one with more vertices first, and for
 //     identical polygons by their relative poses), so that swapping them swaps the points and
@@ -60,6 +61,14 @@
 //     by the rounding of the heights over the tilt (~1e-16 of the size / tilt), the problem's
 //     own conditioning. (Two identical polygons whose relative pose is its own inverse, a half
 //     turn, prefer no order: both roles pose the same problem, whose middle is the same point.)
+//   - Each rule above decides at a threshold (the sine of 1e-12, the factor of two between
+//     slopes, the tolerances at a face's boundary, the 16-ulp band of a vertex just off a face).
+//     A configuration within the rounding of its own inputs of a threshold is decided by that
+//     rounding, which a rigid motion of the scene or the order of the arguments changes: the
+//     rotation made from a quaternion carries ~1e-16 of each length. There the points can move
+//     within the features that tie (a polygon turned 2e-12 rad about an edge whose neighbour on a
+//     6,000-edge arc climbs by 5e-16 gets that edge's middle or the vertex between them), while
+//     phi keeps to the tie tolerance.
 //   - Nearly parallel features that are not parallel by that test (a sine just above 1e-12)
 //     have unique closest points and exact derivatives, computed from cross products of the
 //     features' directions (src/proximity/point_motion.cpp), but the problem is ill-conditioned

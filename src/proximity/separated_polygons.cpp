@@ -87,6 +87,8 @@ struct Candidate {
 // that matters: a unit 64-gon 1e8 above a square and tilted 1e-6 rad from it had its vertex tie
 // with vertex-edge pairs up to sqrt(2 d ulp(d)) ~ 1.7 along the square, whichever rounding made
 // nearest, and the square's point moved by 2 under rigid motions of the scene (a hostile review).
+// So does such a vertex off the face by no more than its rounding, in its pair with the face's
+// boundary (rim_pair): it may be over the face, and is then within rounding of a closest point.
 struct Best {
   Candidate point, interval, vertex_over_face;
   void offer(const Candidate& candidate, bool is_interval) {
@@ -121,6 +123,34 @@ struct Best {
   }
 };
 
+// A support vertex of `polygon` (carried into the frame of `over`, in z = 0) whose shadow y lies
+// just off the face, paired with the face's nearest boundary point: edge e of the face at the
+// parameter s nearest to y, and the vertex as the end (parameter 1) of its polygon's edge
+// `support`. Its distance is the vertex's own, sqrt(z^2 + |y - boundary|^2).
+template <class Over>
+Candidate rim_pair(const Over& over, const Eigen::Vector3d& vertex, Eigen::Index support,
+                   bool polygon_is_b) {
+  const Eigen::Vector2d y = vertex.head<2>();
+  double lateral2 = std::numeric_limits<double>::infinity(), along = 0.0;
+  Eigen::Index edge = 0;
+  for (Eigen::Index e = 0; e < over.size(); ++e) {
+    const Eigen::Vector2d start = over.edge_start(e), run = over.edge_end(e) - start;
+    const double length2 = run.squaredNorm();
+    const double s = length2 > 0.0 ? std::clamp((y - start).dot(run) / length2, 0.0, 1.0) : 0.0;
+    const double apart2 = (start + s * run - y).squaredNorm();
+    if (apart2 < lateral2) lateral2 = apart2, edge = e, along = s;
+  }
+  Candidate c;
+  c.distance2 = vertex.z() * vertex.z() + lateral2;
+  c.kind = Kind::kEdges;
+  if (polygon_is_b) {
+    c.i = edge, c.s = along, c.j = support, c.t = 1.0;
+  } else {
+    c.i = support, c.s = 1.0, c.j = edge, c.t = along;
+  }
+  return c;
+}
+
 // The vertices of `polygon` (carried into the other's frame, where the other lies in z = 0) that
 // could be a closest point over the other's face: the lowest if the polygon lies above the plane,
 // the highest if below. Only a support point in the direction of the plane can be closest over its
@@ -139,7 +169,7 @@ struct Best {
 // both its lowest and its highest vertex.
 template <class Polygon, class Over>
 void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, bool polygon_is_b,
-                     double tolerance, double tie_tolerance, Best& best) {
+                     double tolerance, Best& best) {
   // The extreme vertices by their rises (CarriedPolygon::rise), not by their heights: a rounded
   // rectangle 1 above the face and turned 1e-11 rad from it about its lower straight edge has its
   // corner's first vertices within an ulp of that edge in height (a rise of 3e-17 over 1), and
@@ -167,29 +197,37 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
   };
   const auto offer_support = [&](Eigen::Index support) {
     const Eigen::Vector3d& vertex = polygon[support];
-    // Over the face grown by the smaller of the two tolerances: the vertex's carried coordinates
-    // round to ulps of the scene, and a polygon 1e8 above the face with its lowest vertex 1e-10
-    // from the face's edge was over it or not by rounding. When not, vertex-edge pairs up to ~1.4
-    // along the rim tied with the one below the vertex, and the face's point moved by 1.4 under
-    // rigid motions of the scene (a hostile review). Both tolerances are far above that rounding
-    // (64 ulps of the scene and more). Within the intersection tolerance a point is on the
-    // boundary, as elsewhere, and the face point reported lies at most that far outside it; within
-    // the tie tolerance the height, which the vertex's true distance exceeds by less than the
-    // slack, is a tie with it. (The intersection tolerance alone is too coarse where it exceeds
-    // the polygons' size, as in windows searched as specks: test_large_polygons searches unit
-    // polygons with a tolerance of 1,000, and a vertex 2.3 off the face counted as over it, its
-    // distance 0.79 for 2.4.)
-    if (contains(over, vertex.head<2>(), std::min(tolerance, tie_tolerance))) {
-      const Candidate over_face =
+    // A support vertex over the face is a candidate at its height; one off the face by no more
+    // than the rounding of its coordinates (CarriedPolygon::rounding), which cannot tell whether
+    // it is over the face, is in the pair with the face's nearest boundary point (rim_pair), at
+    // its true distance. Both win rounding ties (Best) when the polygon is clear of the plane.
+    // Far apart that matters: a unit polygon 1e8 above a square with its lowest vertex 1e-10
+    // from the square's edge (its coordinates round to 1.5e-8) came out just off the face under
+    // some rigid motions of the scene, and then vertex-edge pairs up to ~1.4 along the rim tied
+    // with the one below the vertex, and the square's point moved by 1.4 (a hostile review).
+    // Only that rounding, and an honest pair: counted as over the face within the intersection
+    // tolerance, a vertex 1e-12 beyond the edge and 2e-12 above the face got the face's normal,
+    // 26 degrees off the pair's, and one 1e-12 above it was reported touching; and letting a
+    // pair within a tie of the vertex's height win (off the face by up to sqrt(2 |z| tau)) put
+    // the points 1e-5 of the scene from a unique closest pair of edges that the vertex's edge
+    // makes over the face's (the reviews of those versions).
+    const double z = std::abs(vertex.z());
+    std::optional<Candidate> over_face;
+    if (contains(over, vertex.head<2>(), 0.0)) {
+      over_face =
           candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z(), 0.0, 0.0);
+    } else if (contains(over, vertex.head<2>(), polygon.rounding())) {
+      over_face = rim_pair(over, vertex, support, polygon_is_b);
+    }
+    if (over_face) {
       // A vertex within the intersection tolerance of the plane proves nothing beyond it (its
       // polygon may cross the plane by as much, and a pair that touches is as good): a sliver
       // touching a triangle had its vertex win under some rigid motions and a touching edge
       // pair under others, 0.17 apart (a hostile review's fuzzing).
-      if (std::abs(vertex.z()) > tolerance) {
-        best.offer_vertex_over_face(over_face);
+      if (z > tolerance) {
+        best.offer_vertex_over_face(*over_face);
       } else {
-        best.offer(over_face, false);
+        best.offer(*over_face, false);
       }
     }
     // The two edges at the support vertex, each an interval of closest points if parallel to the
@@ -541,8 +579,8 @@ std::array<ClosestFeature, 2> enumerate(const Polygon& a, const Polygon& b,
                                         double tie_tolerance) {
   const Eigen::Index kb = b.size();
   Best best;
-  offer_over_face(W, a, true, tolerance, tie_tolerance, best);
-  offer_over_face(X, b, false, tolerance, tie_tolerance, best);
+  offer_over_face(W, a, true, tolerance, best);
+  offer_over_face(X, b, false, tolerance, best);
   // B's edges in A's frame.
   SmallBuffer<Segment> b_edges(kb);
   for (Eigen::Index j = 0; j < kb; ++j) {
@@ -582,12 +620,18 @@ bool closest_over_face(const PolygonView& face, const SubPolygon& other,
                        const CarriedPolygon<SubPolygon>& carried, bool face_is_a, double tolerance,
                        double tie_tolerance, std::array<ClosestFeature, 2>& out) {
   Best best;
-  offer_over_face(carried, face, face_is_a, tolerance, tie_tolerance, best);
-  const auto sides_of = [&](const Candidate& c) {
-    return over_face_sides(c, other, carried, face_is_a);
+  offer_over_face(carried, face, face_is_a, tolerance, best);
+  const auto sides_of = [&](const Candidate& c) -> std::array<ClosestFeature, 2> {
+    if (c.kind != Kind::kEdges) return over_face_sides(c, other, carried, face_is_a);
+    if (face_is_a) return {edge_point(face, c.i, c.s), edge_point(other, c.j, c.t)};
+    return {edge_point(other, c.i, c.s), edge_point(face, c.j, c.t)};
   };
   const Candidate& chosen = best.choice(tolerance, tie_tolerance, sides_of);
-  if (chosen.distance2 == std::numeric_limits<double>::infinity()) return false;
+  // A support just off the face (rim_pair) is on its boundary too: the caller then takes the
+  // whole face into its window, and the enumeration weighs that pair against the face's edges.
+  if (chosen.distance2 == std::numeric_limits<double>::infinity() || chosen.kind == Kind::kEdges) {
+    return false;
+  }
   out = over_face_sides(chosen, other, carried, face_is_a);
   return true;
 }

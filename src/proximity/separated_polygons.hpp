@@ -4,7 +4,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
+#include <limits>
 
 #include "polygon_features.hpp"
 #include "posed_core.hpp"
@@ -38,9 +40,12 @@ class CarriedPolygon {
         rise_(rotation.template block<1, 2>(2, 0)),
         count_(polygon.size()),
         vertices_(count_) {
+    double reach = 0.0;
     for (Eigen::Index i = 0; i < count_; ++i) {
       vertices_[i] = rotation.template leftCols<2>() * polygon.vertex(i) + translation;
+      reach = std::max(reach, polygon.vertex(i).cwiseAbs().maxCoeff());
     }
+    magnitude_ = translation.cwiseAbs().maxCoeff() + reach;
   }
   const Eigen::Vector3d& operator[](Eigen::Index i) const { return vertices_[i]; }
   // Vertex i's height turned but not translated: [vertex i].z() less the translation's z, without
@@ -57,12 +62,20 @@ class CarriedPolygon {
   }
   const Eigen::Vector3d& end(Eigen::Index j) const { return vertices_[j]; }
   Eigen::Index size() const { return count_; }
+  // How far a carried vertex can be from where exact arithmetic puts it, generously: each
+  // coordinate rounds to a few ulps of the translation plus the vertex (the rotation, the sum,
+  // and the pose's own rounding from the frame), ~4 times less than this. A rigid motion of the
+  // whole scene, rounded where the caller applies it, moves the vertex by ulps of the caller's
+  // coordinates, which this covers only for scenes near the world origin (a scene 1e10 from it
+  // and 1e8 across rounds at 1e10). 16 ulps of that magnitude.
+  double rounding() const { return 16 * std::numeric_limits<double>::epsilon() * magnitude_; }
 
  private:
   const Polygon* polygon_;
   Eigen::RowVector2d rise_;  // the rotation's row z in the polygon's plane
   Eigen::Index count_;
   SmallBuffer<Eigen::Vector3d> vertices_;
+  double magnitude_ = 0.0;  // the translation's largest coordinate plus the vertices'
 };
 
 // W: B's vertices carried into A's frame (frame.b_in_a), X: A's into B's. The candidates (see
@@ -74,7 +87,8 @@ class CarriedPolygon {
 // for every closer pair, and their pairs of parallel edges, the only ones that make an interval,
 // are taken apart within the band. Candidates for a whole interval win ties within the tie
 // tolerance (pair_frame.hpp), and a vertex over the other's face, its polygon clear of that plane,
-// wins them against other pairs (it is a closest point; what ties with it does by rounding).
+// wins them against other pairs (it is a closest point; what ties with it does by rounding), as
+// does its pair with the face's boundary when it lies off the face within its own rounding.
 std::array<ClosestFeature, 2> closest_separated(const PolygonView& a, const PolygonView& b,
                                                 const PolygonPairFrame& frame,
                                                 const CarriedPolygon<PolygonView>& W,
@@ -90,7 +104,8 @@ std::array<ClosestFeature, 2> closest_separated(const SubPolygon& a, const SubPo
 // its normal), the closest pairs are the other's support vertex over that face, or the middle of
 // the part over it of a support edge parallel to it: the over-face candidates of the window
 // `other` (carried into the face's frame) against the whole face. face_is_a: the face is shape
-// a's. Returns false if no such candidate lies over the face (the pair is then on its boundary).
+// a's. Returns false if no such candidate lies over the face (the pair is then on its boundary,
+// also when the nearest support lies just off it).
 bool closest_over_face(const PolygonView& face, const SubPolygon& other,
                        const CarriedPolygon<SubPolygon>& carried, bool face_is_a, double tolerance,
                        double tie_tolerance, std::array<ClosestFeature, 2>& out);
