@@ -219,6 +219,29 @@ PaddedPolygon polygon_through(const std::vector<Eigen::Vector2d>& vertices) {
   return PaddedPolygon(C, d, 0.0);
 }
 
+// The vertices of a regular polygon of `count` sides on the unit circle, the first at `phase`.
+std::vector<Eigen::Vector2d> regular_vertices(int count, double phase) {
+  std::vector<Eigen::Vector2d> vertices;
+  for (int k = 0; k < count; ++k) {
+    const double angle = 2 * M_PI * k / count + phase;
+    vertices.emplace_back(std::cos(angle), std::sin(angle));
+  }
+  return vertices;
+}
+
+// The vertex turned by R (R [v; 0], without a translation) that is lowest, by that rise alone: its
+// height once translated far up would round to ulps of the translation, more than the rises
+// between neighbouring vertices.
+Eigen::Vector3d lowest_turned(const std::vector<Eigen::Vector2d>& vertices,
+                              const Eigen::Matrix3d& R) {
+  Eigen::Vector3d lowest = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  for (const Eigen::Vector2d& v : vertices) {
+    const Eigen::Vector3d turned = R * Eigen::Vector3d(v.x(), v.y(), 0);
+    if (turned.z() < lowest.z()) lowest = turned;
+  }
+  return lowest;
+}
+
 // A rounded rectangle (half-sides 1 and 0.5, corners of radius 0.2 drawn with 200 edges each)
 // 1 above a large square, turned 1e-11 .. 2e-10 rad about its lower straight edge: that edge is
 // the optimal set. The corners' first vertices rise from it by 3e-17 .. 6e-16, below the ulp of
@@ -256,29 +279,15 @@ TEST(OptimalSet, RoundedRectangleTurnedAboutItsLowerEdgeAFewPicoradians) {
 // with it within rounding. The vertex over the face wins those ties; with whichever pair rounding
 // made nearest, the square's point moved by 2 under rigid motions (a hostile review).
 TEST(OptimalSet, FarPolygonsJustPastLevelKeepTheVertexOverTheFace) {
-  std::vector<Eigen::Vector2d> vertices;
-  for (int k = 0; k < 64; ++k) {
-    const double angle = 2 * M_PI * k / 64 + 0.1;
-    vertices.emplace_back(std::cos(angle), std::sin(angle));
-  }
+  const std::vector<Eigen::Vector2d> vertices = regular_vertices(64, 0.1);
   const PaddedPolygon plate = polygon_through(vertices);
   const PaddedPolygon floor = square(3.0, 0.0);
   for (const double height : {1e8, 1e9}) {
     SCOPED_TRACE(height);
     const double tilt = 64 * (std::nextafter(height, 2 * height) - height);
     const Pose turned({0.2, -0.1, height}, about(tilt, std::cos(1.0), std::sin(1.0), 0));
-    // The lowest vertex by its rise, R v . e_z: its height R v . e_z + 1e8 would round to ulps
-    // of 1e8, more than the rise between neighbouring vertices.
-    const Eigen::Matrix3d R = rotation_matrix(turned.q());
-    Eigen::Vector3d lowest = Eigen::Vector3d::Zero();
-    double lowest_rise = std::numeric_limits<double>::infinity();
-    for (const Eigen::Vector2d& v : vertices) {
-      const Eigen::Vector3d turned_vertex = R * Eigen::Vector3d(v.x(), v.y(), 0);
-      if (turned_vertex.z() < lowest_rise) {
-        lowest_rise = turned_vertex.z();
-        lowest = turned_vertex + turned.r();
-      }
-    }
+    const Eigen::Vector3d lowest =
+        lowest_turned(vertices, rotation_matrix(turned.q())) + turned.r();
     expect_middle(floor, Pose(), plate, turned, {lowest.x(), lowest.y(), 0}, lowest, height);
   }
 }
@@ -290,11 +299,7 @@ TEST(OptimalSet, FarPolygonsJustPastLevelKeepTheVertexOverTheFace) {
 // square's point moved by 1.4 under rigid motions (a hostile review). Off the face by no more than
 // its rounding, the vertex is kept in its pair with the edge, as over the face it is kept alone.
 TEST(OptimalSet, FarPolygonWithItsLowestVertexOnTheRim) {
-  std::vector<Eigen::Vector2d> vertices;
-  for (int k = 0; k < 64; ++k) {
-    const double angle = 2 * M_PI * k / 64 + 0.1;
-    vertices.emplace_back(std::cos(angle), std::sin(angle));
-  }
+  const std::vector<Eigen::Vector2d> vertices = regular_vertices(64, 0.1);
   const PaddedPolygon plate = polygon_through(vertices);
   const PaddedPolygon floor = square(3.0, 0.0);
   for (const double height : {1e8, 1e9}) {
@@ -302,12 +307,7 @@ TEST(OptimalSet, FarPolygonWithItsLowestVertexOnTheRim) {
       SCOPED_TRACE(::testing::Message() << height << " " << beyond);
       const double tilt = 512 * (std::nextafter(height, 2 * height) - height);
       const Eigen::Vector4d q = about(tilt, std::cos(0.3), std::sin(0.3), 0);
-      const Eigen::Matrix3d R = rotation_matrix(q);
-      Eigen::Vector3d lowest = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-      for (const Eigen::Vector2d& v : vertices) {
-        const Eigen::Vector3d turned_vertex = R * Eigen::Vector3d(v.x(), v.y(), 0);
-        if (turned_vertex.z() < lowest.z()) lowest = turned_vertex;
-      }
+      const Eigen::Vector3d lowest = lowest_turned(vertices, rotation_matrix(q));
       const Pose turned(Eigen::Vector3d(3.0 + beyond, -0.7, height) - lowest, q);
       const Eigen::Vector3d vertex = lowest + turned.r();  // (3 + beyond, -0.7, height), rounded
       expect_middle(floor, Pose(), plate, turned, {std::min(3.0, vertex.x()), vertex.y(), 0},
@@ -323,22 +323,14 @@ TEST(OptimalSet, FarPolygonWithItsLowestVertexOnTheRim) {
 // intersection tolerance gave the face's normal, and at the lower height reported the cores
 // intersecting (a hostile review). Against the brute force of tests/support/reference.hpp.
 TEST(OptimalSet, LowestVertexJustBeyondTheRimNearContact) {
-  std::vector<Eigen::Vector2d> vertices;
+  const std::vector<Eigen::Vector2d> vertices = regular_vertices(7, 0.3);
   std::vector<Eigen::Vector3d> body_vertices;
-  for (int k = 0; k < 7; ++k) {
-    const double angle = 2 * M_PI * k / 7 + 0.3;
-    vertices.emplace_back(std::cos(angle), std::sin(angle));
-    body_vertices.emplace_back(std::cos(angle), std::sin(angle), 0.0);
-  }
+  for (const Eigen::Vector2d& v : vertices) body_vertices.emplace_back(v.x(), v.y(), 0.0);
   const PaddedPolygon heptagon = polygon_through(vertices);
   const PaddedPolygon floor = square(3.0, 0.0);
   const WorldCore floor_world{{{3, 3, 0}, {-3, 3, 0}, {-3, -3, 0}, {3, -3, 0}}};
   const Eigen::Vector4d q = about(1.4, 0.6, 0.8, 0.0);
-  const Eigen::Matrix3d R = rotation_matrix(q);
-  Eigen::Vector3d lowest = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  for (const Eigen::Vector3d& v : body_vertices) {
-    if ((R * v).z() < lowest.z()) lowest = R * v;
-  }
+  const Eigen::Vector3d lowest = lowest_turned(vertices, rotation_matrix(q));
   for (const double height : {8e-12, 3e-12}) {
     SCOPED_TRACE(height);
     const Pose posed(Eigen::Vector3d(3.0 + 4e-12, 0.4, height) - lowest, q);

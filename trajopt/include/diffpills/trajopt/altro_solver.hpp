@@ -440,6 +440,8 @@ int AltroSolver<Nx, Nu>::polish(Rollout& r) const {
     if (current <= settings_.polish_tolerance) break;
     std::vector<Eigen::Triplet<double>> entries;
     std::vector<double> values;
+    // The initial state's and the dynamics' entries; the active constraints' come on top.
+    entries.reserve(static_cast<std::size_t>(n_) * nx * (1 + nx + nu));
     const auto add_row = [&](double value) {
       values.push_back(value);
       return static_cast<Eigen::Index>(values.size()) - 1;
