@@ -11,6 +11,7 @@
 #include <string>
 #include <thread>
 #include <variant>
+#include <vector>
 
 #include "capsule_rows.hpp"
 #include "diffpills/signed_distance.hpp"
@@ -50,54 +51,90 @@ std::exception_ptr with_row(std::exception_ptr error, Eigen::Index row) {
   }
 }
 
-// Rows [0, rows) in blocks of block_rows (at most kMaxBlockRows) taken from a shared counter by
-// every thread of the job. fast_rows(begin, end, left) answers what it can of a block (the
-// capsule pairs' vector kernel, capsule_rows.hpp) and sets left[i - begin] for each row it leaves;
-// row_work(i) computes and writes row i by the scalar path.
+// Rows [0, rows) in blocks of block_rows (at most kMaxBlockRows), shared by `threads` threads.
+// fast_rows(begin, end, left) answers what it can of a block (the capsule pairs' vector kernel,
+// capsule_rows.hpp) and sets left[i - begin] for each row it leaves; row_work(i) computes and
+// writes row i by the scalar path.
+//
+// Who takes which block: the blocks are cut into `threads` consecutive shares, one per slot
+// (worker_pool.hpp: 0 the calling thread, 1.. the workers), and each share has a counter its
+// blocks are taken from in order. A thread takes the blocks of its own share, then helps with the
+// others' (the next share's counter first), so a thread that joined late or whose rows cost more
+// is helped (pair costs vary: a crossing pair of polygons stops early, a distant one prunes most
+// edge pairs; a fixed split with no help measured 1.79x on two threads against 1.8-1.9x). Taking
+// every block from one counter instead (before this) balanced as well but sent each block to
+// either thread at random, so a loop calling the batch again found half its rows in the other
+// core's cache, and two threads' writes interleaved block by block: 10^4 capsule pairs ran 1.62x
+// faster on two threads and 10^6 1.78x, against 1.82x and 2.1x with the shares (BENCHMARKS.md).
 constexpr Eigen::Index kMaxBlockRows = 512;
 static_assert(kMaxBlockRows <= detail::kCapsuleRowsBlock);
 
 template <class FastRows, class RowWork>
 struct RowsJob final : detail::Job {
-  RowsJob(const FastRows& fast, const RowWork& work, Eigen::Index rows, Eigen::Index block_rows)
+  RowsJob(const FastRows& fast, const RowWork& work, Eigen::Index rows, Eigen::Index block_rows,
+          Eigen::Index threads)
       : fast_rows(fast),
         row_work(work),
         rows(rows),
         block_rows(block_rows),
-        blocks((rows + block_rows - 1) / block_rows),
-        first_error_row(rows) {}
+        shares(static_cast<std::size_t>(threads)),
+        first_error_row(rows) {
+    const Eigen::Index blocks = (rows + block_rows - 1) / block_rows;
+    for (Eigen::Index slot = 0; slot < threads; ++slot) {
+      Share& share = shares[static_cast<std::size_t>(slot)];
+      share.next_block = slot * blocks / threads;
+      share.end_block = (slot + 1) * blocks / threads;
+    }
+  }
 
   // Every exception of a row is caught here and carried to the caller: one escaping a worker
   // would end the process with std::terminate.
-  void run() noexcept override {
-    std::array<std::uint8_t, kMaxBlockRows> left;
-    for (Eigen::Index block = next_block++; block < blocks; block = next_block++) {
-      const Eigen::Index begin = block * block_rows;
-      const Eigen::Index end = std::min(rows, begin + block_rows);
-      if (begin > first_error_row) return;  // a lower row already failed; the rest is moot
-      fast_rows(begin, end, left.data());
-      for (Eigen::Index i = begin; i < end; ++i) {
-        if (left[static_cast<std::size_t>(i - begin)] == 0) continue;
-        try {
-          row_work(i);
-        } catch (...) {
-          // Every block below a failing row is still processed, so the lowest row recorded is
-          // the first bad row whatever the thread timing.
-          const std::lock_guard<std::mutex> lock(error_mutex);
-          if (i < first_error_row) {
-            first_error_row = i;
-            first_error = with_row(std::current_exception(), i);
-          }
-          break;
-        }
+  void run(int slot) noexcept override {
+    const std::size_t count = shares.size();
+    for (std::size_t turn = 0; turn < count; ++turn) {
+      Share& share = shares[(static_cast<std::size_t>(slot) + turn) % count];
+      for (Eigen::Index block = share.next_block++; block < share.end_block;
+           block = share.next_block++) {
+        const Eigen::Index begin = block * block_rows;
+        // A lower row already failed: the rest of this share is moot (its blocks only rise), but
+        // the next share may hold blocks below the failing row, which must still be processed.
+        if (begin > first_error_row) break;
+        run_block(begin, std::min(rows, begin + block_rows));
       }
     }
   }
 
+  void run_block(Eigen::Index begin, Eigen::Index end) {
+    std::array<std::uint8_t, kMaxBlockRows> left;
+    fast_rows(begin, end, left.data());
+    for (Eigen::Index i = begin; i < end; ++i) {
+      if (left[static_cast<std::size_t>(i - begin)] == 0) continue;
+      try {
+        row_work(i);
+      } catch (...) {
+        // Every block below a failing row is still processed, so the lowest row recorded is the
+        // first bad row whatever the thread timing.
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (i < first_error_row) {
+          first_error_row = i;
+          first_error = with_row(std::current_exception(), i);
+        }
+        return;
+      }
+    }
+  }
+
+  // A slot's consecutive blocks [next_block, end_block); a cache line each, so that the threads'
+  // counters do not share one.
+  struct alignas(64) Share {
+    std::atomic<Eigen::Index> next_block{0};
+    Eigen::Index end_block = 0;
+  };
+
   const FastRows& fast_rows;
   const RowWork& row_work;
-  const Eigen::Index rows, block_rows, blocks;
-  std::atomic<Eigen::Index> next_block{0};
+  const Eigen::Index rows, block_rows;
+  std::vector<Share> shares;
   std::atomic<Eigen::Index> first_error_row;
   std::exception_ptr first_error;  // of first_error_row, written under error_mutex
   std::mutex error_mutex;
@@ -142,12 +179,9 @@ void run_batch(const char* name, const char* value_name, const Eigen::Ref<const 
                                 ")");
   }
 
-  // Threads take blocks of rows from a shared counter: pair costs vary (a crossing pair of
-  // polygons stops early, a distant one prunes most edge pairs), and a fixed split into one chunk
-  // per thread left one thread idle while the other finished (1.79x on two threads instead of
-  // 1.8-1.9x). Blocks of 512 rows keep the counter cold; a small batch is cut into at least 16
-  // blocks per thread (of at least 16 rows), so that the threads end within a small block of each
-  // other. Each row is written by exactly one thread; nothing else is shared.
+  // Blocks of 512 rows keep the counters cold; a small batch is cut into at least 16 blocks per
+  // thread (of at least 16 rows), so that the threads end within a small block of each other.
+  // Each row is written by exactly one thread; nothing else is shared.
   const Eigen::Index hardware = std::max(1u, std::thread::hardware_concurrency());
   const Eigen::Index requested = options.threads == 0 ? hardware : options.threads;
   const auto fast_rows = [&](Eigen::Index begin, Eigen::Index end, std::uint8_t* left) noexcept {
@@ -160,12 +194,12 @@ void run_batch(const char* name, const char* value_name, const Eigen::Ref<const 
   const auto row_work = [&](Eigen::Index i) {
     query(pose_at(r_a, q_a, i, 'a'), pose_at(r_b, q_b, i, 'b'), i);
   };
-  RowsJob<decltype(fast_rows), decltype(row_work)> job(
-      fast_rows, row_work, n, std::clamp<Eigen::Index>(n / (16 * hardware), 16, kMaxBlockRows));
+  const Eigen::Index block_rows = std::clamp<Eigen::Index>(n / (16 * hardware), 16, kMaxBlockRows);
+  const Eigen::Index blocks = (n + block_rows - 1) / block_rows;
   // Threads beyond the hardware's only take turns, and threads beyond the blocks find no work, so
   // a request above either is capped: threads = 10^6 uses no more threads than threads = 0.
-  const Eigen::Index threads =
-      std::max<Eigen::Index>(1, std::min({requested, hardware, job.blocks}));
+  const Eigen::Index threads = std::max<Eigen::Index>(1, std::min({requested, hardware, blocks}));
+  RowsJob<decltype(fast_rows), decltype(row_work)> job(fast_rows, row_work, n, block_rows, threads);
   // The calling thread works beside threads - 1 of the process's workers (worker_pool.hpp: started
   // once, reused by every call; a worker the system refuses is one fewer, never an error).
   detail::WorkerPool::instance().run(job, static_cast<int>(threads - 1));

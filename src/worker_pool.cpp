@@ -84,7 +84,7 @@ bool spin_until(const Done& done) {
 void WorkerPool::run(Job& job, int helpers) {
   std::unique_lock<std::mutex> busy(busy_, std::try_to_lock);
   if (!busy.owns_lock() || helpers <= 0) {
-    job.run();
+    job.run(0);
     return;
   }
   start_workers(helpers);
@@ -93,10 +93,11 @@ void WorkerPool::run(Job& job, int helpers) {
     const std::lock_guard<std::mutex> lock(state_);
     job_ = &job;
     wanted_ = available;
+    joined_slots_ = 0;
     generation_.fetch_add(1, std::memory_order_release);
   }
   wake_.notify_all();
-  job.run();
+  job.run(0);
   {
     const std::lock_guard<std::mutex> lock(state_);
     wanted_ = 0;  // late wakers stay out: the work is done or in the hands of those inside
@@ -124,9 +125,10 @@ void WorkerPool::work_loop(std::uint64_t seen) {
     if (wanted_ == 0) continue;  // the job has its helpers, or its caller has finished
     --wanted_;
     ++joined_;
+    const int slot = ++joined_slots_;
     Job* job = job_;
     lock.unlock();
-    job->run();
+    job->run(slot);
     lock.lock();
     if (--joined_ == 0) done_.notify_one();
   }

@@ -24,11 +24,13 @@ namespace diffpills::detail {
 
 // A job is a function every participating thread calls once; it must not throw (each thread's
 // exceptions are the job's to catch and carry). The work inside is shared by the job itself
-// (e.g. blocks of rows taken from an atomic counter), so a job done by fewer threads than asked
-// is still done completely.
+// (e.g. blocks of rows taken from atomic counters), so a job done by fewer threads than asked is
+// still done completely. `slot` tells the participants apart: 0 for the calling thread, 1, 2, ...
+// for the workers in the order they join. A job may give each slot a share of its own to start
+// with (batch.cpp), which a loop calling it again finds in the same thread's caches.
 class Job {
  public:
-  virtual void run() noexcept = 0;
+  virtual void run(int slot) noexcept = 0;
 
  protected:
   ~Job() = default;
@@ -41,13 +43,13 @@ class WorkerPool {
   // a batch running while statics are torn down.
   static WorkerPool& instance();
 
-  // Calls job.run() on the calling thread and on up to helpers workers at once, and returns
-  // when every call has returned. Workers are started on first need, up to helpers; a worker the
-  // system refuses is one helper fewer (tried again by a later call). A worker that wakes only
-  // after the calling thread has finished its own run() is not given the job: the shared work is
-  // then done, and waiting for it would only add its wake-up time. The pool serves one job at a
-  // time: a job submitted while another runs (a batch from a second thread) runs on its calling
-  // thread alone.
+  // Calls job.run(0) on the calling thread and job.run(1), job.run(2), ... on up to helpers
+  // workers at once, and returns when every call has returned. Workers are started on first need,
+  // up to helpers; a worker the system refuses is one helper fewer (tried again by a later call). A
+  // worker that wakes only after the calling thread has finished its own run() is not given the
+  // job: the shared work is then done, and waiting for it would only add its wake-up time. The pool
+  // serves one job at a time: a job submitted while another runs (a batch from a second thread)
+  // runs on its calling thread alone.
   void run(Job& job, int helpers);
 
   WorkerPool(const WorkerPool&) = delete;
@@ -67,6 +69,7 @@ class WorkerPool {
   Job* job_ = nullptr;
   std::atomic<std::uint64_t> generation_{0};  // moved under state_, read while spinning
   int wanted_ = 0;                            // workers the current job may still take
+  int joined_slots_ = 0;                      // workers the current job has taken so far
   std::atomic<int> joined_{0};                // workers inside the job's run(); moved under state_
 };
 

@@ -137,6 +137,34 @@ TEST(Batch, ReportsTheFirstBadRow) {
   }
 }
 
+// Each thread starts on a share of consecutive rows of its own (src/batch.cpp), so the thread of
+// a later share may meet its bad row first; the lower bad row is still the one reported, wherever
+// the two fall: the first and the last share, either side of a share's end, both in one share.
+TEST(Batch, ReportsTheFirstBadRowWhicheverThreadMeetsItFirst) {
+  Rng rng(63);
+  const Shape capsule = Capsule(1.0, 0.1);
+  const Arrays clean = random_arrays(rng, 1000);
+  for (const auto& [low, high] : {std::pair{3, 990}, std::pair{499, 500}, std::pair{249, 750},
+                                  std::pair{700, 710}, std::pair{0, 999}}) {
+    Arrays arrays = clean;
+    arrays.q_b.row(low).setZero();
+    arrays.r_a(high, 0) = std::nan("");
+    for (int threads : {2, 3, 4, 0}) {
+      for (int repeat = 0; repeat < 20; ++repeat) {
+        try {
+          proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b,
+                          {threads});
+          ADD_FAILURE() << "no exception";
+        } catch (const std::invalid_argument& error) {
+          const std::string expected = "q_b[" + std::to_string(low) + "]";
+          ASSERT_EQ(std::string(error.what()).rfind(expected, 0), 0u)
+              << error.what() << " (threads " << threads << ")";
+        }
+      }
+    }
+  }
+}
+
 TEST(Batch, SignedDistanceEntriesEqualTheSingleCall) {
   Rng rng(63);
   const Shape capsule = random_capsule(rng, 1.0).shape;
