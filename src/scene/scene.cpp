@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <tuple>
 #include <utility>
@@ -144,8 +145,24 @@ bool Scene::checked(int i, int j) const {
 }
 
 std::vector<Contact> Scene::contacts(const std::vector<Pose>& body_poses, double margin) const {
+  const std::vector<std::pair<int, int>> pairs =
+      detail::broadphase(*this, *outlines_, body_poses, margin);
+  // A primitive in several pairs (a robot's link beside every board of a shelf) is posed once per
+  // query: world_pose normalises two quaternions, builds a rotation and checks the result.
+  std::vector<std::optional<Pose>> world(outlines_->primitives.size());
+  const auto world_of = [&](int primitive) -> const Pose& {
+    std::optional<Pose>& pose = world[static_cast<std::size_t>(primitive)];
+    if (!pose) {
+      const detail::SceneOutlines::Primitive& p =
+          outlines_->primitives[static_cast<std::size_t>(primitive)];
+      pose = world_pose(body_poses[static_cast<std::size_t>(p.body)],
+                        body(p.body).shapes()[static_cast<std::size_t>(p.shape)].pose);
+    }
+    return *pose;
+  };
   std::vector<Contact> found;
-  for (const auto& [u, v] : detail::broadphase(*this, *outlines_, body_poses, margin)) {
+  found.reserve(pairs.size());
+  for (const auto& [u, v] : pairs) {
     const detail::SceneOutlines::Primitive& first =
         outlines_->primitives[static_cast<std::size_t>(u)];
     const detail::SceneOutlines::Primitive& second =
@@ -154,11 +171,10 @@ std::vector<Contact> Scene::contacts(const std::vector<Pose>& body_poses, double
     const BodyShape& b = body(second.body).shapes()[static_cast<std::size_t>(second.shape)];
     const Pose& pose_a = body_poses[static_cast<std::size_t>(first.body)];
     const Pose& pose_b = body_poses[static_cast<std::size_t>(second.body)];
-    const SignedDistance sd =
-        signed_distance(a.shape, world_pose(pose_a, a.pose), b.shape, world_pose(pose_b, b.pose));
+    const SignedDistance sd = signed_distance(a.shape, world_of(u), b.shape, world_of(v));
     if (!(sd.distance <= margin)) continue;
 
-    Contact contact;
+    Contact& contact = found.emplace_back();
     contact.bodies = {first.body, second.body};
     contact.shapes = {first.shape, second.shape};
     contact.distance = sd.distance;
@@ -173,7 +189,6 @@ std::vector<Contact> Scene::contacts(const std::vector<Pose>& body_poses, double
       contact.phi = sd.distance * (sd.distance + 2.0 * radii);
       contact.phi_gradient = 2.0 * (sd.distance + radii) * contact.gradient;
     }
-    found.push_back(contact);
   }
   std::sort(found.begin(), found.end(), [](const Contact& x, const Contact& y) {
     return std::tie(x.bodies[0], x.bodies[1], x.shapes[0], x.shapes[1]) <
