@@ -232,7 +232,7 @@ ArmShelfProblem::Constraints ArmShelfProblem::evaluate(int k, const State& x, co
       if (!derivatives || contact.distance >= scenario_.query_margin) continue;
       // d distance / dq through the two bodies' frames (the boards and the base do not move),
       // then dq/dx = I and dq/du = (s / S) dt.
-      Eigen::RowVectorXd dq = Eigen::RowVectorXd::Zero(7);
+      Eigen::Matrix<double, 1, 7> dq = Eigen::Matrix<double, 1, 7>::Zero();
       for (int side = 0; side < 2; ++side) {
         const int body = contact.bodies[static_cast<std::size_t>(side)];
         if (body < 1 || body >= kLinks) continue;
