@@ -41,6 +41,7 @@
 #include <vector>
 
 #include "diffpills/shapes.hpp"
+#include "nearest_on_segment.hpp"
 #include "row_predicates.hpp"
 #include "row_scale.hpp"
 #include "validation.hpp"
@@ -87,12 +88,8 @@ Eigen::Vector2d vertex_of(const UnitRow& a, const UnitRow& c) {
 
 double distance_to_segment(const Eigen::Vector2d& point, const Eigen::Vector2d& start,
                            const Eigen::Vector2d& end) {
-  const Eigen::Vector2d along = end - start;
-  const double length_squared = along.squaredNorm();
-  const double t = length_squared > 0.0
-                       ? std::clamp((point - start).dot(along) / length_squared, 0.0, 1.0)
-                       : 0.0;
-  const Eigen::Vector2d gap = point - (start + t * along);
+  const Eigen::Vector2d gap =
+      point - (start + detail::nearest_on_segment(point, start, end) * (end - start));
   return std::hypot(gap.x(), gap.y());
 }
 

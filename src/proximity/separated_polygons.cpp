@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "depth_box_tree.hpp"
+#include "nearest_on_segment.hpp"
 #include "segment_bounds.hpp"
 
 namespace diffpills::detail {
@@ -134,10 +135,9 @@ Candidate rim_pair(const Over& over, const Eigen::Vector3d& vertex, Eigen::Index
   double lateral2 = std::numeric_limits<double>::infinity(), along = 0.0;
   Eigen::Index edge = 0;
   for (Eigen::Index e = 0; e < over.size(); ++e) {
-    const Eigen::Vector2d start = over.edge_start(e), run = over.edge_end(e) - start;
-    const double length2 = run.squaredNorm();
-    const double s = length2 > 0.0 ? std::clamp((y - start).dot(run) / length2, 0.0, 1.0) : 0.0;
-    const double apart2 = (start + s * run - y).squaredNorm();
+    const Eigen::Vector2d start = over.edge_start(e), end = over.edge_end(e);
+    const double s = nearest_on_segment(y, start, end);
+    const double apart2 = (start + s * (end - start) - y).squaredNorm();
     if (apart2 < lateral2) lateral2 = apart2, edge = e, along = s;
   }
   Candidate c;
