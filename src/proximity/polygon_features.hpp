@@ -85,19 +85,36 @@ bool spike_bevel(const Polygon& polygon, Eigen::Index i, Eigen::Vector2d& normal
   return true;
 }
 
-// Is y in the polygon grown by `slack` (every row n . y <= b + slack, and every spike's bevel, see
-// above)? Polygon is a PolygonView or a SubPolygon (sub_polygon.hpp).
+// Where y is against the polygon and the polygon grown by `slack` >= 0 (every row n . y <= b +
+// slack, and every spike's bevel, see above), in one pass over the rows: in the polygon itself,
+// only in the grown one, or outside both. Polygon is a PolygonView or a SubPolygon
+// (sub_polygon.hpp).
+enum class Containment { kInside, kWithinSlack, kOutside };
 template <class Polygon>
-bool contains(const Polygon& polygon, const Eigen::Vector2d& y, double slack) {
+Containment containment(const Polygon& polygon, const Eigen::Vector2d& y, double slack) {
+  bool beyond_a_row = false;
+  const auto outside = [&](double height, double offset) {
+    if (height > offset + slack) return true;
+    beyond_a_row = beyond_a_row || height > offset;
+    return false;
+  };
   for (Eigen::Index j = 0; j < polygon.size(); ++j) {
-    if (polygon.normal(j).dot(y) > polygon.offset(j) + slack) return false;
+    if (outside(polygon.normal(j).dot(y), polygon.offset(j))) return Containment::kOutside;
   }
   Eigen::Vector2d normal;
   double offset = 0.0;
   for (Eigen::Index i = 0; i < polygon.size(); ++i) {
-    if (spike_bevel(polygon, i, normal, offset) && normal.dot(y) > offset + slack) return false;
+    if (spike_bevel(polygon, i, normal, offset) && outside(normal.dot(y), offset)) {
+      return Containment::kOutside;
+    }
   }
-  return true;
+  return beyond_a_row ? Containment::kWithinSlack : Containment::kInside;
+}
+
+// Is y in the polygon grown by `slack`?
+template <class Polygon>
+bool contains(const Polygon& polygon, const Eigen::Vector2d& y, double slack) {
+  return containment(polygon, y, slack) != Containment::kOutside;
 }
 
 // The parameter interval {s in [0, 1] : y0 + s w in the polygon grown by `slack`} (Cyrus-Beck

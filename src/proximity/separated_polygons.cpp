@@ -213,11 +213,16 @@ void offer_over_face(const CarriedPolygon<Polygon>& polygon, const Over& over, b
     // makes over the face's (the reviews of those versions).
     const double z = std::abs(vertex.z());
     std::optional<Candidate> over_face;
-    if (contains(over, vertex.head<2>(), 0.0)) {
-      over_face =
-          candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z(), 0.0, 0.0);
-    } else if (contains(over, vertex.head<2>(), polygon.rounding())) {
-      over_face = rim_pair(over, vertex, support, polygon_is_b);
+    switch (containment(over, vertex.head<2>(), polygon.rounding())) {
+      case Containment::kInside:
+        over_face =
+            candidate(Kind::kBVertexOverA, Kind::kAVertexOverB, support, 1.0, vertex.z(), 0.0, 0.0);
+        break;
+      case Containment::kWithinSlack:
+        over_face = rim_pair(over, vertex, support, polygon_is_b);
+        break;
+      case Containment::kOutside:
+        break;
     }
     if (over_face) {
       // A vertex within the intersection tolerance of the plane proves nothing beyond it (its
