@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -324,8 +325,9 @@ TEST(OptimalSet, FarPolygonWithItsLowestVertexOnTheRim) {
 // intersecting (a hostile review). Against the brute force of tests/support/reference.hpp.
 TEST(OptimalSet, LowestVertexJustBeyondTheRimNearContact) {
   const std::vector<Eigen::Vector2d> vertices = regular_vertices(7, 0.3);
-  std::vector<Eigen::Vector3d> body_vertices;
-  for (const Eigen::Vector2d& v : vertices) body_vertices.emplace_back(v.x(), v.y(), 0.0);
+  std::vector<Eigen::Vector3d> body_vertices(vertices.size());
+  std::transform(vertices.begin(), vertices.end(), body_vertices.begin(),
+                 [](const Eigen::Vector2d& v) { return Eigen::Vector3d(v.x(), v.y(), 0.0); });
   const PaddedPolygon heptagon = polygon_through(vertices);
   const PaddedPolygon floor = square(3.0, 0.0);
   const WorldCore floor_world{{{3, 3, 0}, {-3, 3, 0}, {-3, -3, 0}, {3, -3, 0}}};
