@@ -11,7 +11,6 @@
 #include <string>
 #include <thread>
 #include <variant>
-#include <vector>
 
 #include "capsule_rows.hpp"
 #include "diffpills/signed_distance.hpp"
@@ -56,8 +55,8 @@ std::exception_ptr with_row(std::exception_ptr error, Eigen::Index row) {
 // capsule_rows.hpp) and sets left[i - begin] for each row it leaves; row_work(i) computes and
 // writes row i by the scalar path.
 //
-// Who takes which block: the blocks are cut into `threads` consecutive shares, one per slot
-// (worker_pool.hpp: 0 the calling thread, 1.. the workers), and each share has a counter its
+// Who takes which block: the blocks are cut into shares of consecutive blocks, one per thread's
+// slot (worker_pool.hpp: 0 the calling thread, 1.. the workers), and each share has a counter its
 // blocks are taken from in order. A thread takes the blocks of its own share, then helps with the
 // others' (the next share's counter first), so a thread that joined late or whose rows cost more
 // is helped (pair costs vary: a crossing pair of polygons stops early, a distant one prunes most
@@ -66,7 +65,12 @@ std::exception_ptr with_row(std::exception_ptr error, Eigen::Index row) {
 // either thread at random, so a loop calling the batch again found half its rows in the other
 // core's cache, and two threads' writes interleaved block by block: 10^4 capsule pairs ran 1.62x
 // faster on two threads and 10^6 1.78x, against 1.82x and 2.1x with the shares (BENCHMARKS.md).
+//
+// The shares live in the job, on the calling thread's stack (the batch into caller-owned outputs
+// allocates nothing, batch.hpp): at most kMaxShares of them. Beyond that many threads, slots
+// share a share's counter (slot % kMaxShares), which only makes them take its blocks in turn.
 constexpr Eigen::Index kMaxBlockRows = 512;
+constexpr Eigen::Index kMaxShares = 64;
 static_assert(kMaxBlockRows <= detail::kCapsuleRowsBlock);
 
 template <class FastRows, class RowWork>
@@ -77,20 +81,20 @@ struct RowsJob final : detail::Job {
         row_work(work),
         rows(rows),
         block_rows(block_rows),
-        shares(static_cast<std::size_t>(threads)),
+        share_count(std::min(threads, kMaxShares)),
         first_error_row(rows) {
     const Eigen::Index blocks = (rows + block_rows - 1) / block_rows;
-    for (Eigen::Index slot = 0; slot < threads; ++slot) {
-      Share& share = shares[static_cast<std::size_t>(slot)];
-      share.next_block = slot * blocks / threads;
-      share.end_block = (slot + 1) * blocks / threads;
+    for (Eigen::Index k = 0; k < share_count; ++k) {
+      Share& share = shares[static_cast<std::size_t>(k)];
+      share.next_block = k * blocks / share_count;
+      share.end_block = (k + 1) * blocks / share_count;
     }
   }
 
   // Every exception of a row is caught here and carried to the caller: one escaping a worker
   // would end the process with std::terminate.
   void run(int slot) noexcept override {
-    const std::size_t count = shares.size();
+    const auto count = static_cast<std::size_t>(share_count);
     for (std::size_t turn = 0; turn < count; ++turn) {
       Share& share = shares[(static_cast<std::size_t>(slot) + turn) % count];
       for (Eigen::Index block = share.next_block++; block < share.end_block;
@@ -133,8 +137,8 @@ struct RowsJob final : detail::Job {
 
   const FastRows& fast_rows;
   const RowWork& row_work;
-  const Eigen::Index rows, block_rows;
-  std::vector<Share> shares;
+  const Eigen::Index rows, block_rows, share_count;
+  std::array<Share, kMaxShares> shares;
   std::atomic<Eigen::Index> first_error_row;
   std::exception_ptr first_error;  // of first_error_row, written under error_mutex
   std::mutex error_mutex;

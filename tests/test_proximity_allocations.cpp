@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "diffpills/diffpills.hpp"
 #include "support/allocation_counter.hpp"
@@ -63,6 +64,39 @@ TEST(ProximityAllocations, NoneUpToThirtyTwoVertices) {
   // The counter sees allocations: a polygon of 33 vertices stacked on another takes the heap.
   const PaddedPolygon large = regular(33);
   EXPECT_GT(allocations_of(large, Pose(), large, Pose({0.3, 0.2, 1.0}, level)), 0);
+}
+
+// The batch into caller-owned outputs allocates nothing (batch.hpp), on one thread or several:
+// the threads' shares of the rows live on the calling thread's stack, the workers are started by
+// the first call. Capsule pairs (the vector kernel, and its degenerate rows left to the single
+// call) and hexagon pairs.
+TEST(ProximityAllocations, NoneInABatchIntoCallerOutputs) {
+  if (!testing::kCountingAllocations) GTEST_SKIP() << "AddressSanitizer defines malloc";
+  constexpr Eigen::Index kRows = 3000;
+  PositionArray r_a(kRows, 3), r_b(kRows, 3);
+  QuaternionArray q_a(kRows, 4), q_b(kRows, 4);
+  for (Eigen::Index i = 0; i < kRows; ++i) {
+    const double t = static_cast<double>(i);
+    r_a.row(i) << std::sin(0.3 * t), std::cos(0.7 * t), 0.5 * std::sin(0.11 * t);
+    r_b.row(i) << std::cos(0.2 * t), std::sin(0.5 * t), 0.5 * std::cos(0.13 * t);
+    q_a.row(i) << 1.0, 0.3 * std::sin(t), 0.2 * std::cos(t), 0.1;
+    // Every tenth row's capsules parallel: rows the vector kernel leaves to the single call.
+    q_b.row(i) = i % 10 == 0 ? q_a.row(i) : Eigen::RowVector4d(0.5, std::cos(t), 0.3, -0.2);
+  }
+  Eigen::VectorXd phi(kRows);
+  GradientArray gradient(kRows, 14);
+  const Capsule capsule(1.0, 0.1);
+  const PaddedPolygon hexagon = regular(6);
+  for (const int threads : {1, 2, 0}) {
+    SCOPED_TRACE("threads = " + std::to_string(threads));
+    for (const auto& [a, b] :
+         {std::pair<Shape, Shape>{capsule, capsule}, std::pair<Shape, Shape>{hexagon, hexagon}}) {
+      proximity_batch(a, r_a, q_a, b, r_b, q_b, phi, gradient, {threads});
+      const long before = testing::heap_allocations();
+      proximity_batch(a, r_a, q_a, b, r_b, q_b, phi, gradient, {threads});
+      EXPECT_EQ(testing::heap_allocations() - before, 0);
+    }
+  }
 }
 
 }  // namespace
