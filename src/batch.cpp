@@ -63,8 +63,9 @@ std::exception_ptr with_row(std::exception_ptr error, Eigen::Index row) {
 // edge pairs; a fixed split with no help measured 1.79x on two threads against 1.8-1.9x). Taking
 // every block from one counter instead (before this) balanced as well but sent each block to
 // either thread at random, so a loop calling the batch again found half its rows in the other
-// core's cache, and two threads' writes interleaved block by block: 10^4 capsule pairs ran 1.62x
-// faster on two threads and 10^6 1.78x, against 1.82x and 2.1x with the shares (BENCHMARKS.md).
+// core's cache, and two threads' writes interleaved block by block. In paired runs, two threads
+// ran 10^4 capsule pairs 1.42-1.67x faster than one with the single counter and 1.61-1.91x with
+// the shares, 10^6 pairs 1.64-1.78x and 1.87-2.2x (BENCHMARKS.md, 2026-11-28).
 //
 // The shares live in the job, on the calling thread's stack (the batch into caller-owned outputs
 // allocates nothing, batch.hpp): at most kMaxShares of them. Beyond that many threads, slots

@@ -16,8 +16,8 @@ Eigen::Vector4d about_z(double angle) {
   return {std::cos(0.5 * angle), 0.0, 0.0, std::sin(0.5 * angle)};
 }
 // The Hamilton product a (x) b = [a0 b0 - av.bv ; a0 bv + b0 av + av x bv], written out: it runs
-// ~60 times per pose of the arm (left_multiply_matrix(a) * b, the same sums, built a 4 x 4 matrix
-// in the library first).
+// ~60 times per pose of the arm, and left_multiply_matrix(a) * b built a 4 x 4 matrix in the
+// library first (the same terms, summed in another order: equal to rounding, ~1e-16 relative).
 Eigen::Vector4d product(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
   return {a(0) * b(0) - a(1) * b(1) - a(2) * b(2) - a(3) * b(3),
           a(0) * b(1) + a(1) * b(0) + a(2) * b(3) - a(3) * b(2),
