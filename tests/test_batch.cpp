@@ -4,7 +4,6 @@
 // The threads are the process's worker pool: reused across calls, shared by callers on several
 // threads, and started anew in a forked child.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,7 +13,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <string>
 #include <thread>
@@ -22,6 +20,7 @@
 #include <vector>
 
 #include "diffpills/diffpills.hpp"
+#include "support/address_space.hpp"
 #include "support/random_shapes.hpp"
 
 namespace diffpills::testing {
@@ -229,30 +228,6 @@ TEST(Batch, AMillionThreadsAreCappedAndGiveTheSingleCalls) {
   EXPECT_TRUE(equals_single_calls(capsule, capsule, arrays, most.phi, most.gradient));
 }
 
-// Address-space limits do not mix with the sanitizers' shadow memory.
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define DIFFPILLS_TEST_SANITIZED
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define DIFFPILLS_TEST_SANITIZED
-#endif
-#ifdef DIFFPILLS_TEST_SANITIZED
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-
-// The process's address space (VmSize of /proc/self/status), in bytes.
-rlim_t address_space() {
-  std::ifstream status("/proc/self/status");
-  for (std::string line; std::getline(status, line);) {
-    if (line.rfind("VmSize:", 0) == 0) return std::stoull(line.substr(7)) * 1024;
-  }
-  return 0;
-}
-
 // Runs a 20,000-row batch (40 blocks) in a child process whose address space may grow by only
 // `headroom` bytes past its inputs and outputs, so that the system refuses threads once their
 // stacks (8 MB each by default) no longer fit; the child exits with 0 if every row equals the
@@ -267,10 +242,7 @@ void expect_batch_within_address_space(rlim_t headroom, int threads) {
   GradientArray gradient(20'000, 14);
   EXPECT_EXIT(
       {
-        rlimit limit{};
-        getrlimit(RLIMIT_AS, &limit);
-        limit.rlim_cur = address_space() + headroom;
-        setrlimit(RLIMIT_AS, &limit);
+        limit_address_space(headroom);
         proximity_batch(capsule, arrays.r_a, arrays.q_a, capsule, arrays.r_b, arrays.q_b, phi,
                         gradient, {threads});
         std::exit(equals_single_calls(capsule, capsule, arrays, phi, gradient) ? 0 : 1);

@@ -11,13 +11,16 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <random>
+#include <string>
 #include <tuple>
 #include <vector>
 
 #include "diffpills/diffpills.hpp"
 #include "scene/box_tree.hpp"
+#include "support/address_space.hpp"
 #include "support/random_shapes.hpp"
 #include "support/scene_helpers.hpp"
 
@@ -426,6 +429,33 @@ TEST(Scene, AMovedFromSceneIsTheEmptyScene) {
   const Scene copy = target;  // copies share the outlines and both answer
   EXPECT_EQ(copy.contacts(poses, 0.0).size(), 1u);
   EXPECT_EQ(target.contacts(poses, 0.0).size(), 1u);
+}
+
+// Memory grows with the contacts a query finds, not with the pairs its broadphase finds: 3,000
+// parallel sticks along a diagonal, 0.003 apart, have every pair's boxes overlapping (4.5 million
+// pairs) and no contact at margin 0. With a contact reserved per pair (336 bytes each, 1.5 GB)
+// the query threw std::bad_alloc under this limit (a hostile review); it needs ~40 MB for its
+// pairs. Run in a child process whose address space may grow by 600 MB.
+TEST(Scene, ContactsTakeMemoryForContactsNotForPairs) {
+  if (kSanitized) GTEST_SKIP() << "address-space limit under a sanitizer";
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  constexpr int kSticks = 3000;
+  std::vector<Body> bodies;
+  std::vector<Pose> poses;
+  const Eigen::Vector4d diagonal(std::cos(-M_PI / 8), 0, std::sin(-M_PI / 8), 0);  // x to (1,0,1)
+  for (int i = 0; i < kSticks; ++i) {
+    bodies.emplace_back("stick" + std::to_string(i),
+                        std::vector<BodyShape>{{Capsule(10.0, 0.001), Pose()}});
+    const double across = 0.003 * i * std::sqrt(0.5);  // along (1, 0, -1) / sqrt(2)
+    poses.emplace_back(Eigen::Vector3d(across, 0.0, -across), diagonal);
+  }
+  const Scene scene(std::move(bodies));
+  EXPECT_EXIT(
+      {
+        limit_address_space(600 << 20);
+        std::exit(scene.contacts(poses, 0.0).empty() ? 0 : 1);
+      },
+      ::testing::ExitedWithCode(0), "");
 }
 
 TEST(Scene, ErrorsNameTheField) {
