@@ -5,6 +5,8 @@
 #include <set>
 #include <stdexcept>
 
+#include "json_line.hpp"
+
 namespace diffpills::app {
 namespace {
 
@@ -48,7 +50,7 @@ void reject_unknown_fields(const Input& object, const std::set<std::string>& all
                            const std::string& name) {
   for (const auto& item : object.items()) {
     if (allowed.count(item.key()) == 0) {
-      fail(name + "." + item.key(), "unknown field");
+      fail(name + "." + key_text(item.key()), "unknown field");
     }
   }
 }

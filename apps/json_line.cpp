@@ -115,7 +115,7 @@ class LineBuilder {
       if (level.container->is_array()) {
         out += "[" + std::to_string(level.index) + "]";
       } else if (level.member_open) {
-        out += (out.empty() ? "" : ".") + level.key;
+        out += (out.empty() ? "" : ".") + key_text(level.key);
       }
     }
     return out.empty() || out[0] == '[' ? "query" + out : out;
@@ -197,6 +197,11 @@ json parse_json_line(const std::string& line, const std::string& expected) {
   // nlohmann skips the byte order mark itself, so byte positions count it.
   if (!json::sax_parse(line, &builder)) throw std::invalid_argument(builder.error());
   return std::move(root.value);
+}
+
+std::string key_text(const std::string& key) {
+  const std::string quoted = json(key).dump(-1, ' ', false, json::error_handler_t::replace);
+  return quoted.substr(1, quoted.size() - 2);
 }
 
 }  // namespace diffpills::app

@@ -25,6 +25,13 @@ constexpr std::size_t kMaxNesting = 64;
 // object, or nesting deeper than kMaxNesting arrays and objects.
 nlohmann::json parse_json_line(const std::string& line, const std::string& expected);
 
+// A key or a name from the input as an error message shows it: JSON-escaped without the quotes
+// (control characters as \u00XX, bytes that are not UTF-8 replaced), so that a plain key stays as
+// it is. A NUL byte, which "\u0000" in a key decodes to, would otherwise end the message where it
+// is read back through what() as a C string: {"a\u0000": 1} was answered {"error":"a"}, the
+// message lost and the field misnamed (a hostile review).
+std::string key_text(const std::string& key);
+
 // Empties `value` without allocating, so that destroying it allocates nothing either. nlohmann's
 // destructor first moves a non-empty container's children into a new vector (to free deep values
 // without recursion), and that allocation fails where memory ran out, inside a destructor: a

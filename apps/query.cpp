@@ -30,7 +30,7 @@ nlohmann::ordered_json answer_valid_query(const json& query) {
       "a", "b", "hessian", "jacobian", "method", "shape_gradient", "signed_distance"};
   for (const auto& item : query.items()) {
     if (allowed.count(item.key()) == 0) {
-      throw std::invalid_argument(item.key() + ": unknown field");
+      throw std::invalid_argument(key_text(item.key()) + ": unknown field");
     }
   }
   for (const char* key : {"a", "b"}) {

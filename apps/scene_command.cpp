@@ -28,7 +28,7 @@ nlohmann::ordered_json answer(const Scene& scene, double default_margin, const j
   }
   for (const auto& item : query.items()) {
     if (item.key() != "poses" && item.key() != "margin") {
-      throw std::invalid_argument(item.key() + ": unknown field");
+      throw std::invalid_argument(key_text(item.key()) + ": unknown field");
     }
   }
   double margin = default_margin;
@@ -46,16 +46,17 @@ nlohmann::ordered_json answer(const Scene& scene, double default_margin, const j
   std::vector<bool> posed(static_cast<std::size_t>(scene.size()), false);
   for (const auto& item : given.items()) {
     const int index = scene.index_of(item.key());
+    const std::string field = "poses." + key_text(item.key());
     if (index < 0) {
-      throw std::invalid_argument("poses." + item.key() + ": no body is named '" + item.key() +
-                                  "'");
+      throw std::invalid_argument(field + ": no body is named '" + key_text(item.key()) + "'");
     }
-    poses[static_cast<std::size_t>(index)] = parse_pose(item.value(), "poses." + item.key());
+    poses[static_cast<std::size_t>(index)] = parse_pose(item.value(), field);
     posed[static_cast<std::size_t>(index)] = true;
   }
   for (int i = 0; i < scene.size(); ++i) {
     if (!posed[static_cast<std::size_t>(i)]) {
-      throw std::invalid_argument("poses: body '" + scene.body(i).name() + "' has no pose");
+      throw std::invalid_argument("poses: body '" + key_text(scene.body(i).name()) +
+                                  "' has no pose");
     }
   }
   std::vector<Contact> found;
@@ -63,7 +64,7 @@ nlohmann::ordered_json answer(const Scene& scene, double default_margin, const j
     found = scene.contacts(poses, margin);
   } catch (const BodyPoseError& error) {
     // Named as the line names it: the body's pose is poses.<name>.
-    throw std::invalid_argument("poses." + scene.body(error.body()).name() + ", shape " +
+    throw std::invalid_argument("poses." + key_text(scene.body(error.body()).name()) + ", shape " +
                                 std::to_string(error.shape()) + ": " + error.reason());
   }
   // Released, not destroyed, if building it throws (json_line.hpp's release).

@@ -33,4 +33,17 @@ void fail_negative(double value, const std::string& field) {
   fail(field, "must be >= 0 (got " + format_number(value) + ")");
 }
 
+std::string printable(const std::string& name) {
+  std::string text;
+  text.reserve(name.size());
+  for (const char c : name) {
+    if (c == '\0') {
+      text += "\\u0000";
+    } else {
+      text += c;
+    }
+  }
+  return text;
+}
+
 }  // namespace diffpills::detail

@@ -30,6 +30,12 @@ std::string format_number(double value);
 // "field: problem (got value)".
 [[noreturn]] void fail(const std::string& field, const std::string& problem);
 
+// A caller's name (a body's, one in an exclusion) as it goes into a message, with each NUL byte
+// written \u0000: a message is read back through what(), a C string, and ended at the first NUL
+// (a hostile review: a body named "a\0b" made errors read "... body 'a"). Other bytes stay as
+// given; the command line escapes them in its JSON answers.
+std::string printable(const std::string& name);
+
 template <class FieldName>
 void require_finite(double value, const FieldName& field) {
   if (!(std::abs(value) <= kMaxMagnitude)) {  // false for NaN too

@@ -223,6 +223,19 @@ TEST(Cli, BadInputGetsAnErrorNamingTheField) {
                "b.radius");
 }
 
+// A key holding "\u0000" (a NUL once decoded) is named with it written out: the message is read
+// back through what(), a C string, and a raw NUL ended it ({"a\u0000": 1} was answered
+// {"error":"a"}, the field misnamed and the problem lost).
+TEST(Cli, KeysWithANulAreNamedInFull) {
+  expect_error(R"({"a\u0000": 1})", R"(a\u0000: unknown field)");
+  expect_error(query_with(kCapsule, kPolygon, R"(, "x\u0000y": 1)"), R"(x\u0000y: unknown field)");
+  expect_error(query_with(R"({"type": "capsule", "length": 1, "radius": 0.1, "r": [0,0,0],
+      "q": [1,0,0,0], "l\u0000": 2})",
+                          kPolygon),
+               R"(a.l\u0000: unknown field)");
+  expect_error(R"({"a\u0000": [1, )", R"(a\u0000[1]: malformed JSON)");
+}
+
 TEST(Cli, EveryLineIsAnsweredInOrder) {
   std::istringstream in(query_with(kCapsule, kPolygon) + "\nnot json\n\n" +
                         query_with(kPolygon, kCapsule) + "\n");

@@ -488,6 +488,25 @@ TEST(Scene, ErrorsNameTheField) {
   });
   EXPECT_EQ(far,
             "body_poses[1] (body 'b'), shape 0: its world position is beyond 1e100 in magnitude");
+  // A NUL in a name is written \u0000: read back through what(), a C string, the message ended
+  // there ("... no body is named 'x").
+  const std::string nul_name("x\0y", 3);
+  EXPECT_EQ(message([&] {
+              Scene({a}, {{"a", nul_name}});
+            }),
+            "exclude[0]: no body is named 'x\\u0000y'");
+  const Body named_nul(nul_name,
+                       {{Capsule(1, 0.1), Pose(Eigen::Vector3d(1e100, 0, 0), kIdentity)}});
+  EXPECT_EQ(message([&] {
+              Scene({named_nul, named_nul});
+            }),
+            "bodies[1].name: 'x\\u0000y' is also the name of bodies[0]");
+  EXPECT_EQ(
+      message([&] {
+        Scene({a, named_nul}).contacts({Pose(), Pose(Eigen::Vector3d(1e100, 0, 0), kIdentity)});
+      }),
+      "body_poses[1] (body 'x\\u0000y'), shape 0: its world position is beyond 1e100 in "
+      "magnitude");
 }
 
 }  // namespace

@@ -151,6 +151,36 @@ TEST(SceneCli, BadLinesGetAnErrorAndTheNextLinesAreAnswered) {
   EXPECT_EQ(blank["error"], "query: empty line; expected a JSON object with a field \"poses\"");
 }
 
+// A body named with "\u0000" (a NUL once decoded) is named with it written out in every error:
+// the message is read back through what(), a C string, and a raw NUL ended it ("poses: body 'a").
+TEST(SceneCli, NamesWithANulAreWrittenInFull) {
+  const std::string path = write_file("scene_nul.json", R"({"bodies": [
+      {"name": "a\u0000b", "shapes": [{"type": "capsule", "length": 0.5, "radius": 0.1,
+                                        "r": [1e100, 0, 0], "q": [1, 0, 0, 0]}]},
+      {"name": "c", "shapes": []}]})");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"poses": {"c": {"r": [0,0,0], "q": [1,0,0,0]}}})",
+       R"(poses: body 'a\u0000b' has no pose)"},
+      {R"({"poses": {"a\u0000b": {"r": [1e100,0,0], "q": [1,0,0,0]}, "c": {"r": [0,0,0], "q": [1,0,0,0]}}})",
+       R"(poses.a\u0000b, shape 0: its world position is beyond 1e100)"},
+      {R"({"poses": {"z\u0000": {"r": [0,0,0], "q": [1,0,0,0]}}})",
+       R"(poses.z\u0000: no body is named 'z\u0000')"},
+      {R"({"poses": {}, "m\u0000": 1})", R"(m\u0000: unknown field)"},
+  };
+  std::string input;
+  for (const auto& [line, _] : cases) input += line + "\n";
+  const CommandRun result = run({path}, input);
+  std::istringstream answers(result.out);
+  std::string line;
+  for (const auto& [query, expected] : cases) {
+    ASSERT_TRUE(std::getline(answers, line));
+    const json error = json::parse(line);
+    ASSERT_TRUE(error.contains("error")) << query;
+    EXPECT_EQ(error["error"].get<std::string>().rfind(expected, 0), 0u)
+        << query << " -> " << error["error"];
+  }
+}
+
 // A pose that puts a primitive beyond 1e100 is named as the line names it: poses.<body>.
 TEST(SceneCli, APrimitiveBeyondTheLimitIsNamedByTheLinesField) {
   const std::string path = write_file("far_scene.json", R"({"bodies": [

@@ -17,6 +17,7 @@
 #include "diffpills/rotation.hpp"
 #include "diffpills/signed_distance.hpp"
 #include "scene_outlines.hpp"
+#include "validation.hpp"
 
 namespace diffpills {
 namespace {
@@ -52,8 +53,9 @@ double radius_of(const Shape& shape) {
 }  // namespace
 
 BodyPoseError::BodyPoseError(int body, const std::string& body_name, int shape, std::string reason)
-    : std::invalid_argument("body_poses[" + std::to_string(body) + "] (body '" + body_name +
-                            "'), shape " + std::to_string(shape) + ": " + reason),
+    : std::invalid_argument("body_poses[" + std::to_string(body) + "] (body '" +
+                            detail::printable(body_name) + "'), shape " + std::to_string(shape) +
+                            ": " + reason),
       body_(body),
       shape_(shape),
       reason_(std::move(reason)) {}
@@ -112,18 +114,22 @@ Scene::Scene(std::vector<Body> bodies,
       const int first = std::min(names_[k].second, names_[k - 1].second);
       const int second = std::max(names_[k].second, names_[k - 1].second);
       throw std::invalid_argument("bodies[" + std::to_string(second) + "].name: '" +
-                                  names_[k].first + "' is also the name of bodies[" +
-                                  std::to_string(first) + "]");
+                                  detail::printable(names_[k].first) +
+                                  "' is also the name of bodies[" + std::to_string(first) + "]");
     }
   }
   for (std::size_t k = 0; k < exclude.size(); ++k) {
     const std::string field = "exclude[" + std::to_string(k) + "]";
     const int i = index_of(exclude[k].first), j = index_of(exclude[k].second);
     for (const auto& [index, name] : {std::pair{i, &exclude[k].first}, {j, &exclude[k].second}}) {
-      if (index < 0) throw std::invalid_argument(field + ": no body is named '" + *name + "'");
+      if (index < 0) {
+        throw std::invalid_argument(field + ": no body is named '" + detail::printable(*name) +
+                                    "'");
+      }
     }
     if (i == j)
-      throw std::invalid_argument(field + ": names body '" + exclude[k].first + "' twice");
+      throw std::invalid_argument(field + ": names body '" + detail::printable(exclude[k].first) +
+                                  "' twice");
     excluded_.emplace_back(std::min(i, j), std::max(i, j));
   }
   std::sort(excluded_.begin(), excluded_.end());
