@@ -75,7 +75,11 @@
 //     there: the points' Jacobians, of size ~1 / sin, carry a relative error of ~eps / sin, and
 //     the Hessian an absolute error of ~eps times the Jacobians' size squared (two segments
 //     twisted by 1e-7: 0.03 on a Hessian of size 4; below a twist of ~1e-8 it is noise).
-//     python/tests/test_near_parallel.py checks both against 50 digits.
+//     The points themselves are as sensitive: a change of the inputs by their rounding moves
+//     them along the features by ~eps D / sin^2, D the features' gap (two unit segments 1 apart
+//     and twisted by 1e-7 by 0.2: anywhere along the overlap below ~1e-8), and they are exact to
+//     about that (~eps / sin where the gap is of the twist's order); phi and the distance keep
+//     to ~1e-16 of the scene. python/tests/test_near_parallel.py checks both against 50 digits.
 //   - Zero length capsules are spheres.
 //   - Intersecting cores (|p1 - p2| <= 1e-12 of the scene's size): cores_intersect is true,
 //     phi = -(R1 + R2)^2 and its gradient vanishes up to rounding (the proximity is flat there:
