@@ -63,6 +63,30 @@ std::string write_file(const std::string& name, const std::string& text) {
   return path;
 }
 
+// Sends each case's query line to `diffpills scene path`, each followed by `good` if given, and
+// checks that the command ends with status 1, that every query is answered by an error holding
+// its expected text, and that every `good` line is answered with contacts.
+void expect_error_answers(const std::string& path,
+                          const std::vector<std::pair<std::string, std::string>>& cases,
+                          const std::string& good = "") {
+  std::string input;
+  for (const auto& [line, _] : cases) input += line + "\n" + (good.empty() ? "" : good + "\n");
+  const CommandRun result = run({path}, input);
+  EXPECT_EQ(result.status, 1);
+  std::istringstream answers(result.out);
+  std::string line;
+  for (const auto& [query, expected] : cases) {
+    ASSERT_TRUE(std::getline(answers, line));
+    const json error = json::parse(line);
+    ASSERT_TRUE(error.contains("error")) << query;
+    EXPECT_NE(error["error"].get<std::string>().find(expected), std::string::npos)
+        << query << " -> " << error["error"];
+    if (good.empty()) continue;
+    ASSERT_TRUE(std::getline(answers, line));
+    EXPECT_TRUE(json::parse(line).contains("contacts")) << line;
+  }
+}
+
 TEST(SceneCli, AnswerMatchesTheLibrary) {
   const Scene scene = parse_scene(json::parse(kScene));
   const json query = json::parse(kPoses);
@@ -126,21 +150,7 @@ TEST(SceneCli, BadLinesGetAnErrorAndTheNextLinesAreAnswered) {
       {R"({"poses": {"link1": {"r": [0,0,0], "q": [1,0,0,0], "w": 1}}})",
        "poses.link1.w: unknown field"},
   };
-  std::string input;
-  for (const auto& [line, _] : cases) input += line + "\n" + good + "\n";
-  const CommandRun result = run({path}, input);
-  EXPECT_EQ(result.status, 1);
-  std::istringstream answers(result.out);
-  std::string line;
-  for (const auto& [query, expected] : cases) {
-    ASSERT_TRUE(std::getline(answers, line));
-    const json error = json::parse(line);
-    ASSERT_TRUE(error.contains("error")) << query;
-    EXPECT_NE(error["error"].get<std::string>().find(expected), std::string::npos)
-        << query << " -> " << error["error"];
-    ASSERT_TRUE(std::getline(answers, line));
-    EXPECT_TRUE(json::parse(line).contains("contacts")) << line;
-  }
+  expect_error_answers(path, cases, good);
   // A margin that is not a number, or not finite (1e400 is beyond a double).
   EXPECT_NE(run({path}, R"({"poses": {}, "margin": "x"})"
                         "\n")
@@ -167,18 +177,7 @@ TEST(SceneCli, NamesWithANulAreWrittenInFull) {
        R"(poses.z\u0000: no body is named 'z\u0000')"},
       {R"({"poses": {}, "m\u0000": 1})", R"(m\u0000: unknown field)"},
   };
-  std::string input;
-  for (const auto& [line, _] : cases) input += line + "\n";
-  const CommandRun result = run({path}, input);
-  std::istringstream answers(result.out);
-  std::string line;
-  for (const auto& [query, expected] : cases) {
-    ASSERT_TRUE(std::getline(answers, line));
-    const json error = json::parse(line);
-    ASSERT_TRUE(error.contains("error")) << query;
-    EXPECT_EQ(error["error"].get<std::string>().rfind(expected, 0), 0u)
-        << query << " -> " << error["error"];
-  }
+  expect_error_answers(path, cases);
 }
 
 // A pose that puts a primitive beyond 1e100 is named as the line names it: poses.<body>.
