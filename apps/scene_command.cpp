@@ -46,9 +46,10 @@ nlohmann::ordered_json answer(const Scene& scene, double default_margin, const j
   std::vector<bool> posed(static_cast<std::size_t>(scene.size()), false);
   for (const auto& item : given.items()) {
     const int index = scene.index_of(item.key());
-    const std::string field = "poses." + key_text(item.key());
+    const std::string name = key_text(item.key());
+    const std::string field = "poses." + name;
     if (index < 0) {
-      throw std::invalid_argument(field + ": no body is named '" + key_text(item.key()) + "'");
+      throw std::invalid_argument(field + ": no body is named '" + name + "'");
     }
     poses[static_cast<std::size_t>(index)] = parse_pose(item.value(), field);
     posed[static_cast<std::size_t>(index)] = true;

@@ -50,10 +50,10 @@ std::exception_ptr with_row(std::exception_ptr error, Eigen::Index row) {
   }
 }
 
-// Rows [0, rows) in blocks of block_rows (at most kMaxBlockRows), shared by `threads` threads.
-// fast_rows(begin, end, left) answers what it can of a block (the capsule pairs' vector kernel,
-// capsule_rows.hpp) and sets left[i - begin] for each row it leaves; row_work(i) computes and
-// writes row i by the scalar path.
+// Rows [0, rows) in `blocks` blocks of block_rows (at most kMaxBlockRows), shared by `threads`
+// threads. fast_rows(begin, end, left) answers what it can of a block (the capsule pairs' vector
+// kernel, capsule_rows.hpp) and sets left[i - begin] for each row it leaves; row_work(i) computes
+// and writes row i by the scalar path.
 //
 // Who takes which block: the blocks are cut into shares of consecutive blocks, one per thread's
 // slot (worker_pool.hpp: 0 the calling thread, 1.. the workers), and each share has a counter its
@@ -77,14 +77,13 @@ static_assert(kMaxBlockRows <= detail::kCapsuleRowsBlock);
 template <class FastRows, class RowWork>
 struct RowsJob final : detail::Job {
   RowsJob(const FastRows& fast, const RowWork& work, Eigen::Index rows, Eigen::Index block_rows,
-          Eigen::Index threads)
+          Eigen::Index blocks, Eigen::Index threads)
       : fast_rows(fast),
         row_work(work),
         rows(rows),
         block_rows(block_rows),
         share_count(std::min(threads, kMaxShares)),
         first_error_row(rows) {
-    const Eigen::Index blocks = (rows + block_rows - 1) / block_rows;
     for (Eigen::Index k = 0; k < share_count; ++k) {
       Share& share = shares[static_cast<std::size_t>(k)];
       share.next_block = k * blocks / share_count;
@@ -204,7 +203,8 @@ void run_batch(const char* name, const char* value_name, const Eigen::Ref<const 
   // Threads beyond the hardware's only take turns, and threads beyond the blocks find no work, so
   // a request above either is capped: threads = 10^6 uses no more threads than threads = 0.
   const Eigen::Index threads = std::max<Eigen::Index>(1, std::min({requested, hardware, blocks}));
-  RowsJob<decltype(fast_rows), decltype(row_work)> job(fast_rows, row_work, n, block_rows, threads);
+  RowsJob<decltype(fast_rows), decltype(row_work)> job(fast_rows, row_work, n, block_rows, blocks,
+                                                       threads);
   // The calling thread works beside threads - 1 of the process's workers (worker_pool.hpp: started
   // once, reused by every call; a worker the system refuses is one fewer, never an error).
   detail::WorkerPool::instance().run(job, static_cast<int>(threads - 1));
