@@ -725,5 +725,45 @@ TEST(Ipopt, ExactHessianNeedsSecondDerivatives) {
   EXPECT_TRUE(examples::solve_problem_with_ipopt(problem, VectorXd::Ones(1), guess).solved);
 }
 
+// A run says what stopped it, by Ipopt's return code (IpReturnCodes_inc.h's values).
+TEST(Ipopt, StatusNamesWhatStoppedTheRun) {
+  EXPECT_EQ(examples::ipopt_status_text(0), "solved");
+  EXPECT_EQ(examples::ipopt_status_text(1), "acceptable point (1)");
+  EXPECT_EQ(examples::ipopt_status_text(2), "locally infeasible (2)");
+  EXPECT_EQ(examples::ipopt_status_text(-1), "iteration limit (-1)");
+  EXPECT_EQ(examples::ipopt_status_text(-4), "time limit (-4)");
+  EXPECT_EQ(examples::ipopt_status_text(-199), "stopped (-199)");
+}
+
+// The demo's limit on a run's CPU time stops Ipopt and is reported; a limit that is not positive
+// is refused (Ipopt would ignore it and run unlimited).
+TEST(Ipopt, CpuTimeLimitStopsTheRun) {
+  const examples::CarBusProblem problem{examples::CarBusScenario{}};
+  const std::vector<VectorXd> guess = problem.straight_line_controls();
+  const VectorXd& x0 = problem.scenario().x0;
+  const examples::IpoptRun unlimited = examples::solve_problem_with_ipopt(problem, x0, guess);
+  ASSERT_TRUE(unlimited.solved) << unlimited.status;
+  const examples::IpoptRun stopped = examples::solve_problem_with_ipopt(
+      problem, x0, guess, examples::IpoptHessian::kLimitedMemory, 1e-9);
+  EXPECT_FALSE(stopped.solved);
+  EXPECT_EQ(stopped.status, "time limit (-4)");
+  EXPECT_LT(stopped.iterations, unlimited.iterations);
+  EXPECT_TRUE(unlimited.has_point());
+  // The point handed back is where Ipopt stopped, near the straight-line guess, which drives
+  // through the bus (phi -0.84): its cost and violation are evaluated from it (Ipopt 3.11 hands
+  // back zeros for both at the time limit).
+  ASSERT_TRUE(stopped.has_point());
+  std::cout << "[car-bus] stopped by the time limit: cost " << stopped.cost << ", max violation "
+            << stopped.max_violation << "\n";
+  EXPECT_GT(stopped.cost, 0.0);
+  EXPECT_GT(stopped.max_violation, 0.1);
+  for (const double limit : {0.0, -1.0, std::nan("")}) {
+    EXPECT_THROW(examples::solve_problem_with_ipopt(problem, x0, guess,
+                                                    examples::IpoptHessian::kLimitedMemory, limit),
+                 std::invalid_argument)
+        << limit;
+  }
+}
+
 }  // namespace
 }  // namespace diffpills::trajopt

@@ -3,6 +3,7 @@
 #include <IpTNLP.hpp>
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "ipopt/knot_hessian.hpp"
 #include "ipopt/timed_solve.hpp"
@@ -153,11 +154,15 @@ class CarBusNlp : public Ipopt::TNLP {
         rows, cols, values);
   }
 
-  void finalize_solution(Ipopt::SolverReturn status, Index, const Number* z, const Number*,
-                         const Number*, Index, const Number* g, const Number*, Number objective,
+  void finalize_solution(Ipopt::SolverReturn status, Index n, const Number* z, const Number*,
+                         const Number*, Index m, const Number*, const Number*, Number,
                          const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     run.solved = status == Ipopt::SUCCESS;
-    run.cost = objective;
+    // The cost and the violation are evaluated here at the point handed back: Ipopt 3.11 hands
+    // back zeros for its objective and constraint values when it stops at the time limit.
+    eval_f(n, z, true, run.cost);
+    std::vector<Number> g(static_cast<std::size_t>(m));
+    eval_g(n, z, false, m, g.data());
     run.max_violation = 0.0;
     for (int i = 0; i < layout_.defects(); ++i)
       run.max_violation = std::max(run.max_violation, std::abs(g[i]));

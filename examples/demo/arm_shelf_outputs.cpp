@@ -75,7 +75,7 @@ ArmShelfRun solve_arm_shelf(const ArmShelfProblem& problem, const DemoSettings& 
   run.path_min_distance = arm_shelf_path_min_distance(problem, run.result.states, 20);
   if (!settings.quick) {
     run.ipopt = fastest_ipopt(run.runs, [&](IpoptHessian hessian) {
-      return solve_problem_with_ipopt(problem, s.start, guess, hessian);
+      return solve_problem_with_ipopt(problem, s.start, guess, hessian, settings.ipopt_cpu_seconds);
     });
   }
   return run;

@@ -23,7 +23,7 @@ struct ArmShelfRun {
 };
 
 // ALTRO and Ipopt (both Hessians) from the retreating guess, each solved settings.runs(true)
-// times (once: Ipopt's runs take up to a minute) and its fastest run kept.
+// times (once: Ipopt's runs take seconds to minutes) and its fastest run kept.
 ArmShelfRun solve_arm_shelf(const ArmShelfProblem& problem, const DemoSettings& settings);
 
 // A header line "t,q1,q2,q3,q4,q5,q6,q7", then one row per knot.

@@ -29,9 +29,12 @@ nlohmann::ordered_json altro_summary(const trajopt::AltroResult& result, double 
 }
 
 nlohmann::ordered_json ipopt_summary(const IpoptRun& run) {
-  return {
-      {"hessian", to_string(run.hessian)},  {"status", run.status}, {"iterations", run.iterations},
-      {"max_violation", run.max_violation}, {"cost", run.cost},     {"solve_ms", run.solve_ms}};
+  const auto of_point = [&run](double value) {
+    return run.has_point() ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
+  };
+  return {{"hessian", to_string(run.hessian)}, {"status", run.status},
+          {"iterations", run.iterations},      {"max_violation", of_point(run.max_violation)},
+          {"cost", of_point(run.cost)},        {"solve_ms", run.solve_ms}};
 }
 
 }  // namespace diffpills::examples

@@ -49,7 +49,7 @@ QuadrotorWindowRun solve_quadrotor_window(const QuadrotorWindowProblem& problem,
   run.solve_ms = altro.solve_ms;
   if (!settings.quick) {
     run.ipopt = fastest_ipopt(run.runs, [&](IpoptHessian hessian) {
-      return solve_problem_with_ipopt(problem, s.x0, guess, hessian);
+      return solve_problem_with_ipopt(problem, s.x0, guess, hessian, settings.ipopt_cpu_seconds);
     });
   }
   run.min_phi = INFINITY;

@@ -3,6 +3,8 @@
 #include <IpIpoptApplication.hpp>
 #include <IpSolveStatistics.hpp>
 #include <chrono>
+#include <stdexcept>
+#include <string>
 
 #include "timed_solve.hpp"
 
@@ -24,13 +26,40 @@ const char* to_string(IpoptHessian hessian) {
   return hessian == IpoptHessian::kExact ? "exact" : "limited-memory";
 }
 
+std::string ipopt_status_text(int status) {
+  const auto with_code = [status](const char* what) {
+    return std::string(what) + " (" + std::to_string(status) + ")";
+  };
+  switch (status) {
+    case Ipopt::Solve_Succeeded:
+      return "solved";
+    case Ipopt::Solved_To_Acceptable_Level:
+      return with_code("acceptable point");
+    case Ipopt::Infeasible_Problem_Detected:
+      return with_code("locally infeasible");
+    case Ipopt::Maximum_Iterations_Exceeded:
+      return with_code("iteration limit");
+    case Ipopt::Maximum_CpuTime_Exceeded:
+      return with_code("time limit");
+    default:
+      return with_code("stopped");
+  }
+}
+
 IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& result,
-                     IpoptHessian hessian) {
+                     IpoptHessian hessian, double max_cpu_seconds) {
+  // Ipopt refuses a limit <= 0 with a message on its own output and keeps its default, which
+  // would run without the limit asked for.
+  if (!(max_cpu_seconds > 0.0)) {
+    throw std::invalid_argument("max_cpu_seconds: must be positive, got " +
+                                std::to_string(max_cpu_seconds));
+  }
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetStringValue("hessian_approximation", to_string(hessian));
   app->Options()->SetNumericValue("tol", 1e-8);
   app->Options()->SetNumericValue("constr_viol_tol", 1e-6);
   app->Options()->SetIntegerValue("max_iter", 3000);
+  app->Options()->SetNumericValue("max_cpu_time", max_cpu_seconds);
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");  // no banner
   // "": no options file. Ipopt otherwise reads ./ipopt.opt, and the runs would depend on the
@@ -47,8 +76,7 @@ IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& re
   IpoptRun run = result;
   run.hessian = hessian;
   run.solve_ms = solve_ms;
-  run.status =
-      status == Ipopt::Solve_Succeeded ? "solved" : "failed (" + std::to_string(status) + ")";
+  run.status = ipopt_status_text(status);
   if (Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics(); IsValid(statistics)) {
     run.iterations = statistics->IterationCount();
   }

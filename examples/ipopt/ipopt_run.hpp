@@ -17,15 +17,28 @@ namespace diffpills::examples {
 enum class IpoptHessian { kLimitedMemory, kExact };
 const char* to_string(IpoptHessian hessian);  // "limited-memory", "exact"
 
+// Ipopt's own limit on a run's CPU seconds (its option max_cpu_time) when none is asked for.
+inline constexpr double kNoIpoptTimeLimit = 1e6;
+
+// What an Ipopt return status means, as the runs report it: "solved" for Solve_Succeeded, else
+// what stopped the run and Ipopt's code: "acceptable point (1)" (Solved_To_Acceptable_Level: the
+// tolerances were not reached, looser ones were for 15 iterations), "locally infeasible (2)",
+// "iteration limit (-1)", "time limit (-4)", "stopped (N)" for the rest (IpReturnCodes_inc.h).
+std::string ipopt_status_text(int status);
+
 struct IpoptRun {
   IpoptHessian hessian = IpoptHessian::kLimitedMemory;
   bool solved = false;
-  std::string status;
+  std::string status;  // ipopt_status_text
   int iterations = 0;
   double cost = 0.0;
   double max_violation = 0.0;  // the largest dynamics defect or constraint violation
   double solve_ms = 0.0;
   std::vector<Eigen::VectorXd> states, controls;
+  // Whether Ipopt handed back its last point (its finalize_solution, which it skips for errors
+  // before it starts, such as an option out of range): the cost, max_violation, states and
+  // controls are that point's, evaluated from it.
+  bool has_point() const { return !states.empty(); }
 };
 
 // x0 and the states the controls lead to through the problem's dynamics: Ipopt starts from this

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "knot_hessian.hpp"
 #include "timed_solve.hpp"
@@ -165,11 +166,15 @@ class ProblemNlp : public Ipopt::TNLP {
         rows, cols, values);
   }
 
-  void finalize_solution(Ipopt::SolverReturn status, Index, const Number* z, const Number*,
-                         const Number*, Index, const Number* g, const Number*, Number objective,
+  void finalize_solution(Ipopt::SolverReturn status, Index n, const Number* z, const Number*,
+                         const Number*, Index m, const Number*, const Number*, Number,
                          const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     run.solved = status == Ipopt::SUCCESS;
-    run.cost = objective;
+    // The cost and the violation are evaluated here at the point handed back: Ipopt 3.11 hands
+    // back zeros for its objective and constraint values when it stops at the time limit.
+    eval_f(n, z, true, run.cost);
+    std::vector<Number> g(static_cast<std::size_t>(m));
+    eval_g(n, z, false, m, g.data());
     run.max_violation = 0.0;
     for (Index i = 0; i < n_ * (knots_ - 1); ++i) {
       run.max_violation = std::max(run.max_violation, std::abs(g[i]));
@@ -247,13 +252,13 @@ class ProblemNlp : public Ipopt::TNLP {
 
 IpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
                                   const std::vector<Eigen::VectorXd>& initial_controls,
-                                  IpoptHessian hessian) {
+                                  IpoptHessian hessian, double max_cpu_seconds) {
   if (hessian == IpoptHessian::kExact && !problem.has_second_derivatives()) {
     throw std::invalid_argument("hessian: the problem supplies no second derivatives");
   }
   const std::vector<Eigen::VectorXd> states = rollout(problem, x0, initial_controls);
   Ipopt::SmartPtr<ProblemNlp> nlp = new ProblemNlp(problem, x0, states, initial_controls);
-  return solve_timed(nlp, nlp->run, hessian);
+  return solve_timed(nlp, nlp->run, hessian, max_cpu_seconds);
 }
 
 }  // namespace diffpills::examples

@@ -8,7 +8,8 @@
 // Hessian approximation or the exact Hessian of the Lagrangian from the problem's second
 // derivatives (block diagonal by knot: knot_hessian.hpp), started from the rollout of the initial
 // controls, as ALTRO is. kExact needs problem.has_second_derivatives() (else
-// std::invalid_argument). A fixed-size problem is seen through trajopt::DynamicProblem.
+// std::invalid_argument). A run stops after max_cpu_seconds of CPU time (status "time limit (-4)").
+// A fixed-size problem is seen through trajopt::DynamicProblem.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,15 +23,17 @@ namespace diffpills::examples {
 
 IpoptRun solve_problem_with_ipopt(const trajopt::Problem& problem, const Eigen::VectorXd& x0,
                                   const std::vector<Eigen::VectorXd>& initial_controls,
-                                  IpoptHessian hessian = IpoptHessian::kLimitedMemory);
+                                  IpoptHessian hessian = IpoptHessian::kLimitedMemory,
+                                  double max_cpu_seconds = kNoIpoptTimeLimit);
 
 template <int Nx, int Nu>
 IpoptRun solve_problem_with_ipopt(const trajopt::ProblemOf<Nx, Nu>& problem,
                                   const Eigen::VectorXd& x0,
                                   const std::vector<Eigen::VectorXd>& initial_controls,
-                                  IpoptHessian hessian = IpoptHessian::kLimitedMemory) {
+                                  IpoptHessian hessian = IpoptHessian::kLimitedMemory,
+                                  double max_cpu_seconds = kNoIpoptTimeLimit) {
   return solve_problem_with_ipopt(trajopt::DynamicProblem<Nx, Nu>(problem), x0, initial_controls,
-                                  hessian);
+                                  hessian, max_cpu_seconds);
 }
 
 }  // namespace diffpills::examples

@@ -8,11 +8,12 @@
 
 namespace diffpills::examples {
 
-// Solves nlp with the given Hessian (the NLP's eval_h for kExact), tol 1e-8, constr_viol_tol 1e-6
-// and at most 3,000 iterations (no options file), timing the solve alone (not option parsing).
-// `result` is where the NLP's finalize_solution writes, read after the solve; the run returned is
-// it with the Hessian used, the status, the iteration count and the time.
+// Solves nlp with the given Hessian (the NLP's eval_h for kExact), tol 1e-8, constr_viol_tol 1e-6,
+// at most 3,000 iterations and max_cpu_seconds of CPU time (no options file), timing the solve
+// alone (not option parsing); std::invalid_argument unless max_cpu_seconds > 0. `result` is where
+// the NLP's finalize_solution writes, read after the solve; the run returned is it with the Hessian
+// used, the status, the iteration count and the time.
 IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& result,
-                     IpoptHessian hessian);
+                     IpoptHessian hessian, double max_cpu_seconds = kNoIpoptTimeLimit);
 
 }  // namespace diffpills::examples

@@ -153,6 +153,21 @@ class _SceneContacts(torch.autograd.Function):
         )
 
 
+def _floating(name, tensor):
+    """TypeError naming ``name`` unless the tensor holds float64 or float32 (the element type is
+    part of the type, as numpy arrays of complex or bool are refused with TypeError)."""
+    if tensor.dtype not in (torch.float64, torch.float32):
+        raise TypeError(f"{name}: expected float64 or float32, got {tensor.dtype}")
+
+
+def _like(name, tensor, like, like_name):
+    """TypeError if ``tensor``'s dtype is not ``like``'s, ValueError if its device is not."""
+    if tensor.dtype != like.dtype:
+        raise TypeError(f"{name}: dtype {tensor.dtype} must match {like_name}'s {like.dtype}")
+    if tensor.device != like.device:
+        raise ValueError(f"{name}: device {tensor.device} must match {like_name}'s {like.device}")
+
+
 def _rows(name, tensor, width):
     if not isinstance(tensor, torch.Tensor):
         raise TypeError(f"{name}: expected a torch.Tensor, got {type(tensor).__name__}")
@@ -200,10 +215,8 @@ def _pose_rows(r_a, q_a, r_b, q_b):
     r_b, q_b = _rows("r_b", r_b, 3), _rows("q_b", q_b, 4)
     tensors = {"r_a": r_a, "q_a": q_a, "r_b": r_b, "q_b": q_b}
     for name, tensor in tensors.items():
-        if tensor.dtype not in (torch.float64, torch.float32):
-            raise ValueError(f"{name}: expected float64 or float32, got {tensor.dtype}")
-        if tensor.dtype != r_a.dtype or tensor.device != r_a.device:
-            raise ValueError(f"{name}: dtype and device must match r_a's")
+        _floating(name, tensor)
+        _like(name, tensor, r_a, "r_a")
     n, n_from = 1, None
     for name, tensor in tensors.items():
         if tensor.shape[0] == 1:
@@ -243,8 +256,7 @@ def _shape_parameters(name, shape, like):
         field = f"{name}[{key!r}]"
         if not isinstance(tensor, torch.Tensor):
             raise TypeError(f"{field}: expected a torch.Tensor, got {type(tensor).__name__}")
-        if tensor.dtype != like.dtype or tensor.device != like.device:
-            raise ValueError(f"{field}: dtype and device must match r_a's")
+        _like(field, tensor, like, "r_a")
         tensors.append(tensor)
     if kind == "polygon":
         C, d, radius = tensors
@@ -372,11 +384,8 @@ def scene_contacts(scene, r, q, margin=0.0):
     r and q must share one dtype (float64 or float32) and device; errors as ``Scene.contacts``.
     """
     r, q = _rows("r", r, 3), _rows("q", q, 4)
-    for name, tensor in (("r", r), ("q", q)):
-        if tensor.dtype not in (torch.float64, torch.float32):
-            raise ValueError(f"{name}: expected float64 or float32, got {tensor.dtype}")
-    if q.dtype != r.dtype or q.device != r.device:
-        raise ValueError("q: dtype and device must match r's")
+    _floating("r", r)
+    _like("q", q, r, "r")
     outputs = _SceneContacts.apply(scene, margin, r, q)
     distance, phi, bodies, shapes, points, normal, gradient, phi_gradient = outputs
     return _core.Contacts(bodies, shapes, distance, phi, points, normal, gradient, phi_gradient)

@@ -102,7 +102,7 @@ def test_bad_input():
     q = torch.tensor([[1.0, 0.0, 0.0, 0.0]] * 4, dtype=torch.float64)
     with pytest.raises(ValueError, match="q_a"):
         dtorch.proximity(capsule, r, torch.zeros(4, 3, dtype=torch.float64), capsule, r, q)
-    with pytest.raises(ValueError, match="r_b"):
+    with pytest.raises(TypeError, match="^r_b: dtype torch.float32 must match r_a's torch.float64$"):
         dtorch.proximity(capsule, r, q, capsule, r.float(), q)
     with pytest.raises(ValueError, match="q_b"):
         dtorch.proximity(capsule, r, q, capsule, r, q[:3])
@@ -206,8 +206,14 @@ def test_mismatched_rows_and_bad_arguments_name_them():
         dtorch.proximity(capsule, r, q, capsule, r[:3], q)
     with pytest.raises(ValueError, match="^q_a: expected shape"):
         dtorch.proximity(capsule, r, q[:, :, None], capsule, r, q)
-    with pytest.raises(ValueError, match="^q_b: expected float64 or float32"):
-        dtorch.proximity(capsule, r, q, capsule, r, q.to(torch.complex128))
+    # A tensor's element type is part of its type: TypeError, as for numpy arrays of these.
+    for dtype in (torch.complex128, torch.bool, torch.int64, torch.float16, torch.bfloat16):
+        with pytest.raises(TypeError, match=f"^q_b: expected float64 or float32, got {dtype}$"):
+            dtorch.proximity(capsule, r, q, capsule, r, q.to(dtype))
+        with pytest.raises(TypeError, match=f"^r: expected float64 or float32, got {dtype}$"):
+            dtorch.scene_contacts(diffpills.Scene([]), r.to(dtype), q)
+    with pytest.raises(TypeError, match="^q: dtype torch.float32 must match r's torch.float64$"):
+        dtorch.scene_contacts(diffpills.Scene([]), r, q.float())
     with pytest.raises(ValueError, match=r"^r_a\[1\]: must be finite"):
         dtorch.proximity(capsule, r.index_fill(0, torch.tensor([1]), float("nan")), q, capsule, r, q)
     with pytest.raises(ValueError, match="^threads"):
