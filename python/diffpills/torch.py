@@ -168,9 +168,19 @@ def _like(name, tensor, like, like_name):
         raise ValueError(f"{name}: device {tensor.device} must match {like_name}'s {like.device}")
 
 
-def _rows(name, tensor, width):
+def _readable(name, tensor):
+    """TypeError naming ``name`` unless ``tensor`` is a torch.Tensor laid out densely (strided: not
+    sparse), ValueError if it is on the meta device, which holds no numbers to read."""
     if not isinstance(tensor, torch.Tensor):
         raise TypeError(f"{name}: expected a torch.Tensor, got {type(tensor).__name__}")
+    if tensor.layout != torch.strided:
+        raise TypeError(f"{name}: expected a dense tensor, got layout {tensor.layout}")
+    if tensor.is_meta:
+        raise ValueError(f"{name}: is on the meta device, which holds no numbers")
+
+
+def _rows(name, tensor, width):
+    _readable(name, tensor)
     if tensor.dim() == 1 and tensor.shape[0] == width:
         return tensor.unsqueeze(0)
     if tensor.dim() != 2 or tensor.shape[1] != width:
@@ -254,8 +264,7 @@ def _shape_parameters(name, shape, like):
     for key in _SHAPE_KEYS[kind]:
         tensor = shape[key]
         field = f"{name}[{key!r}]"
-        if not isinstance(tensor, torch.Tensor):
-            raise TypeError(f"{field}: expected a torch.Tensor, got {type(tensor).__name__}")
+        _readable(field, tensor)
         _like(field, tensor, like, "r_a")
         tensors.append(tensor)
     if kind == "polygon":

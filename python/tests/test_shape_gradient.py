@@ -137,6 +137,8 @@ def test_torch_agrees_with_the_batch_and_names_bad_input():
         dtorch.shape_proximity(capsule, origin, identity, {"C": polygon["C"]}, origin, identity)
     with pytest.raises(TypeError, match=r"^b\['d'\]: dtype torch.float32 must match r_a's torch.float64$"):
         dtorch.shape_proximity(capsule, origin, identity, dict(polygon, d=polygon["d"].float()), origin, identity)
+    with pytest.raises(TypeError, match=r"^b\['d'\]: expected a dense tensor"):
+        dtorch.shape_proximity(capsule, origin, identity, dict(polygon, d=polygon["d"].detach().to_sparse()), origin, identity)
     with pytest.raises(ValueError, match=r"^b: expected C of shape \(m, 2\) and d of shape \(m,\)"):
         dtorch.shape_proximity(capsule, origin, identity, dict(polygon, d=polygon["d"][:3]), origin, identity)
     with pytest.raises(ValueError, match=r"^a: capsule.radius: must be >= 0"):

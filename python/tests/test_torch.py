@@ -214,6 +214,14 @@ def test_mismatched_rows_and_bad_arguments_name_them():
             dtorch.scene_contacts(diffpills.Scene([]), r.to(dtype), q)
     with pytest.raises(TypeError, match="^q: dtype torch.float32 must match r's torch.float64$"):
         dtorch.scene_contacts(diffpills.Scene([]), r, q.float())
+    # Tensors whose numbers cannot be read as an array: sparse ones, and the meta device's.
+    with pytest.raises(TypeError, match="^r_b: expected a dense tensor, got layout torch.sparse_coo$"):
+        dtorch.proximity(capsule, r, q, capsule, r.to_sparse(), q)
+    for function in (dtorch.proximity, dtorch.signed_distance):
+        with pytest.raises(ValueError, match="^r_a: is on the meta device"):
+            function(capsule, r.to("meta"), q.to("meta"), capsule, r.to("meta"), q.to("meta"))
+    with pytest.raises(ValueError, match="^r: is on the meta device"):
+        dtorch.scene_contacts(diffpills.Scene([]), r.to("meta"), q.to("meta"))
     with pytest.raises(ValueError, match=r"^r_a\[1\]: must be finite"):
         dtorch.proximity(capsule, r.index_fill(0, torch.tensor([1]), float("nan")), q, capsule, r, q)
     with pytest.raises(ValueError, match="^threads"):
