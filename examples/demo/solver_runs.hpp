@@ -19,12 +19,12 @@ namespace diffpills::examples {
 // the quadrotor and the arm too unless `quick` (the tests' setting: one run each, Ipopt on the
 // car-bus only).
 //
-// Those Ipopt runs stop after ipopt_cpu_seconds of CPU time each. From the same guess as ALTRO,
-// Ipopt's path on these two problems turns on the last bits of the arithmetic: a relative change
-// of 1e-14 in the quadrotor's guess takes it anywhere from a point of cost 6 in 400 iterations to
-// its 3,000-iteration limit (27 s), and the arm's exact-Hessian run has taken from 390 iterations
-// (66 s) to the limit (~15 minutes) (BENCHMARKS.md, 2026-11-28). The limit keeps `make demo` to
-// minutes whichever path this build's rounding takes.
+// Those Ipopt runs stop after ipopt_cpu_seconds of CPU time each (Ipopt counts user time only).
+// From the same guess as ALTRO, Ipopt's path on these two problems turns on the last bits of the
+// arithmetic: a relative change of 1e-14 in the quadrotor's guess takes it anywhere from a point of
+// cost 6 in 400 iterations to its 3,000-iteration limit (27 s), and the arm's exact-Hessian run has
+// taken from 390 iterations (66 s) to the limit (~15 minutes) (BENCHMARKS.md, 2026-11-28). The
+// limit keeps `make demo` to minutes whichever path this build's rounding takes.
 struct DemoSettings {
   int repetitions = 3;
   bool quick = false;
