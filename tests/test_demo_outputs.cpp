@@ -4,7 +4,8 @@
 // parameters the JSON files state; and the arm's motion from the JSON's own description alone
 // (its DH parameters, links, exclusions and shelf): limits, start, goal and the signed distances;
 // and the Ipopt comparison's blocks. The demo runs with --quick (each solver once, Ipopt on the
-// car-bus problem only: the other Ipopt runs take minutes under the sanitizers).
+// car-bus problem only: the other Ipopt runs take minutes under the sanitizers), and once more
+// with its Ipopt runs stopped at once by --ipopt-cpu-seconds.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -20,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "demo_json.hpp"
 #include "diffpills/diffpills.hpp"
 #include "json_io.hpp"
 
@@ -34,17 +36,21 @@ std::string read(const std::filesystem::path& path) {
   return buffer.str();
 }
 
+// Runs the demo with --quick and the extra arguments into a fresh folder named name, its
+// standard output into stdout.txt there.
+std::filesystem::path run_demo(const std::string& name, const std::string& arguments) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  const std::string command = demo_program + " " + folder.string() + " --quick " + arguments +
+                              " > " + (folder / "stdout.txt").string();
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  return folder;
+}
+
 // Runs the demo once into a fresh folder; every test reads it.
 const std::filesystem::path& demo_folder() {
-  static const std::filesystem::path out = [] {
-    const std::filesystem::path folder =
-        std::filesystem::temp_directory_path() / "diffpills_demo_test";
-    std::filesystem::remove_all(folder);
-    const int status =
-        std::system((demo_program + " " + folder.string() + " --quick > /dev/null").c_str());
-    EXPECT_EQ(status, 0);
-    return folder;
-  }();
+  static const std::filesystem::path out = run_demo("diffpills_demo_test", "");
   return out;
 }
 
@@ -306,8 +312,60 @@ TEST(DemoOutputs, IpoptComparison) {
   }
 }
 
+// --ipopt-cpu-seconds reaches the car-bus runs: stopped before they solve, both say
+// "time limit (-4)" in the JSON (with the cost and violation of the point handed back, evaluated:
+// Ipopt's own values there are zeros) and below the table, the table says "failed", and no
+// speed-up is claimed.
+TEST(DemoOutputs, IpoptCpuLimitStopsTheRunsAndIsReported) {
+  const std::filesystem::path out =
+      run_demo("diffpills_demo_limit_test", "--ipopt-cpu-seconds 1e-9");
+  const nlohmann::json car_bus = nlohmann::json::parse(read(out / "car_bus.json"));
+  const std::string printed = read(out / "stdout.txt");
+  for (const auto& [key, label] : {std::pair{"ipopt", "L-M"}, std::pair{"ipopt_exact", "exact"}}) {
+    const nlohmann::json& run = car_bus.at(key);
+    EXPECT_EQ(run["status"], "time limit (-4)") << key;
+    const int iterations = run["iterations"];
+    EXPECT_LT(iterations, 10) << key;  // 0 here: checked before the first step
+    // Near the straight-line guess, which drives through the bus (phi -0.84).
+    EXPECT_GT(run["cost"].get<double>(), 0.0) << key;
+    EXPECT_GT(run["max_violation"].get<double>(), 0.1) << key;
+    const std::string footnote = std::string("car_bus, Ipopt ") + label +
+                                 ": time limit (-4) after " + std::to_string(iterations) +
+                                 " iterations, ";
+    EXPECT_NE(printed.find(footnote), std::string::npos) << footnote << "\n" << printed;
+  }
+  EXPECT_TRUE(car_bus["altro_speedup"].is_null());
+  const std::size_t row = printed.find("\ncar_bus ");
+  ASSERT_NE(row, std::string::npos) << printed;
+  const std::string row_text = printed.substr(row + 1, printed.find('\n', row + 1) - row - 1);
+  EXPECT_EQ(row_text.find("solved"), row_text.rfind("solved")) << row_text;  // ALTRO's only
+  EXPECT_NE(row_text.find("failed"), row_text.rfind("failed")) << row_text;  // both Ipopt runs
+  EXPECT_NE(printed.find("each run stopped after 1e-09 s of CPU time"), std::string::npos);
+}
+
+// An Ipopt block writes null for the cost and the violation of a run that handed back no point
+// (Ipopt skips finalize_solution for errors before it starts; the demo's runs do not reach that,
+// so the block is checked here), and the numbers of one that did.
+TEST(DemoOutputs, IpoptBlockWithoutAPointHasNullCostAndViolation) {
+  diffpills::examples::IpoptRun run;
+  run.hessian = diffpills::examples::IpoptHessian::kExact;
+  run.status = "stopped (-12)";
+  run.cost = 3.5;
+  run.max_violation = 0.25;
+  const nlohmann::ordered_json without_point = diffpills::examples::ipopt_summary(run);
+  EXPECT_EQ(without_point["hessian"], "exact");
+  EXPECT_EQ(without_point["status"], "stopped (-12)");
+  EXPECT_TRUE(without_point["cost"].is_null());
+  EXPECT_TRUE(without_point["max_violation"].is_null());
+  run.states.push_back(Eigen::VectorXd::Zero(2));
+  const nlohmann::ordered_json with_point = diffpills::examples::ipopt_summary(run);
+  EXPECT_EQ(with_point["cost"], 3.5);
+  EXPECT_EQ(with_point["max_violation"], 0.25);
+}
+
 // The demo's command line: --help, a stray or second argument, and a folder it cannot write
-// (an existing one: /proc) end with the documented statuses, not a silent success.
+// (an existing one: /proc) end with the documented statuses, not a silent success; so does an
+// --ipopt-cpu-seconds without a finite positive number of seconds.
 TEST(DemoOutputs, CommandLine) {
   const auto status = [](const std::string& arguments) {
     const int raw = std::system((demo_program + " " + arguments + " > /dev/null 2>&1").c_str());
@@ -318,6 +376,9 @@ TEST(DemoOutputs, CommandLine) {
   EXPECT_EQ(status("-q"), 2);
   EXPECT_EQ(status("one two --quick"), 2);
   EXPECT_EQ(status("/proc --quick"), 1);
+  for (const char* limit : {"", "0", "-1", "nan", "inf", "1e999", "abc", "5s", "--quick"}) {
+    EXPECT_EQ(status(std::string("--quick --ipopt-cpu-seconds ") + limit), 2) << limit;
+  }
 }
 
 }  // namespace

@@ -158,11 +158,9 @@ class CarBusNlp : public Ipopt::TNLP {
                          const Number*, Index m, const Number*, const Number*, Number,
                          const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     run.solved = status == Ipopt::SUCCESS;
-    // The cost and the violation are evaluated here at the point handed back: Ipopt 3.11 hands
-    // back zeros for its objective and constraint values when it stops at the time limit.
-    eval_f(n, z, true, run.cost);
-    std::vector<Number> g(static_cast<std::size_t>(m));
-    eval_g(n, z, false, m, g.data());
+    const PointValues point = evaluate_point(*this, n, z, m);
+    const std::vector<Number>& g = point.constraints;
+    run.cost = point.cost;
     run.max_violation = 0.0;
     for (int i = 0; i < layout_.defects(); ++i)
       run.max_violation = std::max(run.max_violation, std::abs(g[i]));
@@ -222,11 +220,11 @@ class CarBusNlp : public Ipopt::TNLP {
 
 IpoptRun solve_with_ipopt(const CarBusProblem& problem,
                           const std::vector<Eigen::VectorXd>& initial_controls,
-                          IpoptHessian hessian) {
+                          IpoptHessian hessian, double max_cpu_seconds) {
   const std::vector<Eigen::VectorXd> states =
       rollout(problem, problem.scenario().x0, initial_controls);
   Ipopt::SmartPtr<CarBusNlp> nlp = new CarBusNlp(problem, states, initial_controls);
-  return solve_timed(nlp, nlp->run, hessian);
+  return solve_timed(nlp, nlp->run, hessian, max_cpu_seconds);
 }
 
 }  // namespace diffpills::examples

@@ -17,9 +17,11 @@
 
 namespace diffpills::examples {
 
-// Starts from the rollout of initial_controls, as ALTRO does.
+// Starts from the rollout of initial_controls, as ALTRO does; stops after max_cpu_seconds of CPU
+// time (std::invalid_argument unless it is > 0; timed_solve.hpp).
 IpoptRun solve_with_ipopt(const CarBusProblem& problem,
                           const std::vector<Eigen::VectorXd>& initial_controls,
-                          IpoptHessian hessian = IpoptHessian::kLimitedMemory);
+                          IpoptHessian hessian = IpoptHessian::kLimitedMemory,
+                          double max_cpu_seconds = kNoIpoptTimeLimit);
 
 }  // namespace diffpills::examples

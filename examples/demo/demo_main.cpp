@@ -5,17 +5,21 @@
 // is cross-checked with Ipopt from the same guess, with its limited-memory and its exact Hessian,
 // every solver timed the same way (solver_runs.hpp). Prints a summary table.
 //
-// Usage: diffpills_demo [output folder] [--quick]. --quick (the tests') runs each solver once and
-// Ipopt on the car-bus problem only: the quadrotor's and the arm's Ipopt runs take minutes under
-// the sanitizers.
+// Usage: diffpills_demo [output folder] [--quick] [--ipopt-cpu-seconds S]. --quick (the tests')
+// runs each solver once and Ipopt on the car-bus problem only: the quadrotor's and the arm's Ipopt
+// runs take minutes under the sanitizers. --ipopt-cpu-seconds stops each Ipopt run after S > 0
+// seconds of CPU time (default 120; DemoSettings).
 #include <Eigen/Geometry>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -67,7 +71,7 @@ CarBusRun solve_car_bus(const examples::CarBusProblem& problem,
   run.result = std::move(altro.result);
   run.solve_ms = altro.solve_ms;
   run.ipopt = examples::fastest_ipopt(run.runs, [&](examples::IpoptHessian hessian) {
-    return examples::solve_with_ipopt(problem, guess, hessian);
+    return examples::solve_with_ipopt(problem, guess, hessian, settings.ipopt_cpu_seconds);
   });
   return run;
 }
@@ -190,6 +194,24 @@ examples::AltroRun solve_thin_wall(examples::Clearance clearance,
   });
 }
 
+// A run's milliseconds with one decimal, fixed: a minute is 64195.3, not 6.42e+04.
+std::string fixed_ms(double ms) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(1) << ms;
+  return text.str();
+}
+
+// The two Ipopt runs in the table's order, each with its name below the table and the width of
+// its column ("Ipopt L-M ms", "Ipopt exact ms").
+struct LabeledIpoptRun {
+  const examples::IpoptRun* run;
+  const char* label;
+  int column_width;
+};
+std::array<LabeledIpoptRun, 2> labeled_runs(const examples::IpoptRuns& ipopt) {
+  return {{{&ipopt.limited_memory, "L-M", 14}, {&ipopt.exact, "exact", 16}}};
+}
+
 // One row of the summary table: ALTRO's run, then each Ipopt run's time and cost ("failed" for
 // one that did not solve), and ALTRO's speed-up over the faster solved one, marked * where that
 // Ipopt run found another local minimum ("-" without Ipopt).
@@ -205,13 +227,10 @@ void print_row(const std::string& name, const trajopt::AltroResult& result, doub
               << std::setw(12) << "-" << std::setw(10) << "-\n";
     return;
   }
-  for (const auto& [run, width] :
-       {std::pair{&ipopt->limited_memory, 14}, std::pair{&ipopt->exact, 16}}) {
+  for (const auto& [run, label, width] : labeled_runs(*ipopt)) {
     if (run->solved) {
-      std::ostringstream ms;  // fixed: a minute is 64195.3, not 6.42e+04
-      ms << std::fixed << std::setprecision(1) << run->solve_ms;
-      std::cout << std::setw(width) << ms.str() << std::setw(12) << std::setprecision(6)
-                << run->cost;
+      std::cout << std::setw(width) << fixed_ms(run->solve_ms) << std::setw(12)
+                << std::setprecision(6) << run->cost;
     } else {
       std::cout << std::setw(width) << "failed" << std::setw(12) << "-";
     }
@@ -232,13 +251,10 @@ void print_row(const std::string& name, const trajopt::AltroResult& result, doub
 // 255.547 at max violation 0.0625" (or "no point handed back").
 void print_unsolved(const std::string& name, const std::optional<examples::IpoptRuns>& ipopt) {
   if (!ipopt) return;
-  for (const auto& [run, label] :
-       {std::pair{&ipopt->limited_memory, "L-M"}, std::pair{&ipopt->exact, "exact"}}) {
+  for (const auto& [run, label, width] : labeled_runs(*ipopt)) {
     if (run->solved) continue;
-    std::ostringstream ms;
-    ms << std::fixed << std::setprecision(1) << run->solve_ms;
     std::cout << name << ", Ipopt " << label << ": " << run->status << " after " << run->iterations
-              << " iterations, " << ms.str() << " ms, ";
+              << " iterations, " << fixed_ms(run->solve_ms) << " ms, ";
     if (run->has_point()) {
       std::cout << "cost " << std::setprecision(6) << run->cost << " at max violation "
                 << std::setprecision(3) << run->max_violation << "\n";
@@ -248,15 +264,33 @@ void print_unsolved(const std::string& name, const std::optional<examples::Ipopt
   }
 }
 
+// text as a finite number > 0, all of it read ("120", "1e-9"), or nothing.
+std::optional<double> positive_number(const char* text) {
+  char* end = nullptr;
+  const double value = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !std::isfinite(value) || !(value > 0.0)) return std::nullopt;
+  return value;
+}
+
 int run(int argc, char** argv) {
   std::filesystem::path out_dir = "out";
   examples::DemoSettings settings;
   bool folder_given = false;
-  constexpr const char* kUsage = "usage: diffpills_demo [output folder, default out] [--quick]\n";
+  constexpr const char* kUsage =
+      "usage: diffpills_demo [output folder, default out] [--quick] [--ipopt-cpu-seconds S]\n";
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
     if (argument == "--quick") {
       settings.quick = true;
+    } else if (argument == "--ipopt-cpu-seconds") {
+      const std::optional<double> seconds =
+          i + 1 < argc ? positive_number(argv[++i]) : std::nullopt;
+      if (!seconds) {
+        std::cerr << "diffpills_demo: --ipopt-cpu-seconds needs a positive number of seconds\n"
+                  << kUsage;
+        return 2;
+      }
+      settings.ipopt_cpu_seconds = *seconds;
     } else if (argument == "--help" || argument == "-h") {
       std::cout << kUsage;
       return 0;
@@ -308,8 +342,8 @@ int run(int argc, char** argv) {
   print_unsolved("arm_shelf", reach.ipopt);
   std::cout << "\nALTRO and Ipopt from the same guess; the fastest run of " << run.runs
             << " per solver (the arm: " << reach.runs
-            << "); Ipopt with its limited-memory (L-M) and its exact Hessian, each run of the "
-               "quadrotor and the arm stopped after "
+            << "); Ipopt with its limited-memory (L-M) and its exact Hessian, each run stopped "
+               "after "
             << settings.ipopt_cpu_seconds
             << " s of CPU time; speed-up: the faster solved Ipopt's time over ALTRO's (*: that "
                "Ipopt run stopped at another local minimum, its cost more than 1% from ALTRO's)\n";

@@ -19,8 +19,9 @@ namespace diffpills::examples {
 // the quadrotor and the arm too unless `quick` (the tests' setting: one run each, Ipopt on the
 // car-bus only).
 //
-// Those Ipopt runs stop after ipopt_cpu_seconds of CPU time each (Ipopt counts user time only).
-// From the same guess as ALTRO, Ipopt's path on these two problems turns on the last bits of the
+// Every Ipopt run stops after ipopt_cpu_seconds of CPU time (Ipopt counts user time only; the
+// command line's --ipopt-cpu-seconds). The car-bus runs take milliseconds; from the same guess as
+// ALTRO, Ipopt's path on the quadrotor and the arm turns on the last bits of the
 // arithmetic: a relative change of 1e-14 in the quadrotor's guess takes it anywhere from a point of
 // cost 6 in 400 iterations to its 3,000-iteration limit (27 s), and the arm's exact-Hessian run has
 // taken from 390 iterations (66 s) to the limit (~15 minutes) (BENCHMARKS.md, 2026-11-28). The
@@ -28,7 +29,7 @@ namespace diffpills::examples {
 struct DemoSettings {
   int repetitions = 3;
   bool quick = false;
-  double ipopt_cpu_seconds = 120.0;
+  double ipopt_cpu_seconds = kComparisonCpuSeconds;
   int runs(bool slow) const { return quick || slow ? 1 : repetitions; }
 };
 

@@ -3,6 +3,7 @@
 #include <IpIpoptApplication.hpp>
 #include <IpSolveStatistics.hpp>
 #include <chrono>
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -81,6 +82,15 @@ IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& re
     run.iterations = statistics->IterationCount();
   }
   return run;
+}
+
+PointValues evaluate_point(Ipopt::TNLP& nlp, Ipopt::Index n, const Ipopt::Number* z,
+                           Ipopt::Index m) {
+  PointValues values;
+  values.constraints.resize(static_cast<std::size_t>(m));
+  nlp.eval_f(n, z, true, values.cost);
+  nlp.eval_g(n, z, false, m, values.constraints.data());
+  return values;
 }
 
 }  // namespace diffpills::examples

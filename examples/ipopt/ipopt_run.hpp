@@ -19,6 +19,9 @@ const char* to_string(IpoptHessian hessian);  // "limited-memory", "exact"
 
 // Ipopt's own limit on a run's CPU seconds (its option max_cpu_time) when none is asked for.
 inline constexpr double kNoIpoptTimeLimit = 1e6;
+// The limit on each Ipopt run of the demo and of the benchmarks (solver_runs.hpp's DemoSettings
+// says why there is one).
+inline constexpr double kComparisonCpuSeconds = 120.0;
 
 // What an Ipopt return status means, as the runs report it: "solved" for Solve_Succeeded, else
 // what stopped the run and Ipopt's code: "acceptable point (1)" (Solved_To_Acceptable_Level: the

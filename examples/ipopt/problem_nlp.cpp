@@ -170,11 +170,9 @@ class ProblemNlp : public Ipopt::TNLP {
                          const Number*, Index m, const Number*, const Number*, Number,
                          const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     run.solved = status == Ipopt::SUCCESS;
-    // The cost and the violation are evaluated here at the point handed back: Ipopt 3.11 hands
-    // back zeros for its objective and constraint values when it stops at the time limit.
-    eval_f(n, z, true, run.cost);
-    std::vector<Number> g(static_cast<std::size_t>(m));
-    eval_g(n, z, false, m, g.data());
+    const PointValues point = evaluate_point(*this, n, z, m);
+    const std::vector<Number>& g = point.constraints;
+    run.cost = point.cost;
     run.max_violation = 0.0;
     for (Index i = 0; i < n_ * (knots_ - 1); ++i) {
       run.max_violation = std::max(run.max_violation, std::abs(g[i]));

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <IpTNLP.hpp>
+#include <vector>
 
 #include "ipopt_run.hpp"
 
@@ -15,5 +16,15 @@ namespace diffpills::examples {
 // used, the status, the iteration count and the time.
 IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& result,
                      IpoptHessian hessian, double max_cpu_seconds = kNoIpoptTimeLimit);
+
+// The objective and the m constraint values of nlp at the point z (n variables) that Ipopt hands to
+// its finalize_solution, evaluated by nlp's own eval_f and eval_g: Ipopt 3.11 hands back zeros for
+// both when it stops at the time limit, so the runs never read its values.
+struct PointValues {
+  double cost = 0.0;
+  std::vector<Ipopt::Number> constraints;
+};
+PointValues evaluate_point(Ipopt::TNLP& nlp, Ipopt::Index n, const Ipopt::Number* z,
+                           Ipopt::Index m);
 
 }  // namespace diffpills::examples
