@@ -68,6 +68,29 @@ TEST(ArmShelf, ForwardKinematicsIsTheDhProduct) {
   EXPECT_NEAR(rotation_matrix(frames.attitude[8]).col(2).z(), -1.0, 1e-12);
 }
 
+// Posing the chain into the frames of another configuration (the in-place forward_kinematics,
+// which reuses their storage) gives the frames posed into fresh storage, bit for bit.
+TEST(ArmShelf, ForwardKinematicsIntoUsedFramesEqualsFresh) {
+  const PandaArm arm = panda_arm();
+  std::mt19937_64 rng(4);
+  trajopt::ChainFrames used;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Eigen::VectorXd q = random_joints(rng, arm);
+    const bool derivatives = trial % 3 != 1;
+    trajopt::forward_kinematics(arm.chain, q, derivatives, used);
+    const trajopt::ChainFrames fresh = trajopt::forward_kinematics(arm.chain, q, derivatives);
+    EXPECT_EQ(used.origin, fresh.origin);
+    EXPECT_EQ(used.attitude, fresh.attitude);
+    EXPECT_EQ(used.axis, fresh.axis);
+    if (!derivatives) continue;
+    ASSERT_EQ(used.d_origin.size(), fresh.d_origin.size());
+    for (std::size_t f = 0; f < fresh.d_origin.size(); ++f) {
+      EXPECT_EQ(used.d_origin[f], fresh.d_origin[f]) << f;
+      EXPECT_EQ(used.d_attitude[f], fresh.d_attitude[f]) << f;
+    }
+  }
+}
+
 TEST(ArmShelf, ForwardKinematicsJacobiansMatchCentralDifferences) {
   const PandaArm arm = panda_arm();
   std::mt19937_64 rng(2);
@@ -140,6 +163,50 @@ TEST(ArmShelf, ConstraintJacobiansMatchCentralDifferences) {
   }
   EXPECT_GT(near, 500);  // collision rows within the margin, with nonzero derivatives
   EXPECT_GT(checked, 20000);
+}
+
+// write_constraints into storage an earlier call left (the solver's way, which clears only the
+// rows that were within the margin) gives what constraints() and constraint_values() give into
+// fresh storage (cleared whole), value for value and derivative for derivative: along the guess,
+// each knot's storage is handed from knot to knot (so pairs move into and out of the margin
+// between calls) and alternates values-only and derivative calls, and the last knot's storage
+// (another row count) is handed to the first.
+TEST(ArmShelf, ConstraintsWrittenIntoUsedStorageEqualFreshOnes) {
+  const ArmShelfProblem problem{ArmShelfScenario{}};
+  const ArmShelfScenario& s = problem.scenario();
+  const std::vector<Eigen::VectorXd> guess = problem.retreat_controls();
+  std::vector<ArmShelfProblem::State> states{s.start};
+  for (const Eigen::VectorXd& u : guess) states.push_back(states.back() + s.dt * u);
+  const auto control = [&](int k) {
+    return k + 1 < s.knots ? ArmShelfProblem::Control(guess[static_cast<std::size_t>(k)])
+                           : ArmShelfProblem::Control::Zero();
+  };
+  const double far = s.clearance - s.query_margin;
+  ArmShelfProblem::Constraints used;
+  int left_the_margin = 0;  // rows within the margin in the storage, beyond it in the next call
+  for (int round = 0; round < 3; ++round) {
+    for (int k = (round == 0 ? s.knots - 1 : 0); k < s.knots; k += (round == 0 ? 1 : 3)) {
+      const bool derivatives = (k + round) % 2 == 0;
+      const Eigen::VectorXd before = used.value;
+      problem.write_constraints(k, states[static_cast<std::size_t>(k)], control(k), derivatives,
+                                used);
+      const ArmShelfProblem::Constraints fresh =
+          derivatives
+              ? problem.constraints(k, states[static_cast<std::size_t>(k)], control(k))
+              : problem.constraint_values(k, states[static_cast<std::size_t>(k)], control(k));
+      ASSERT_EQ(used.value.size(), fresh.value.size()) << k;
+      EXPECT_EQ(used.equalities, fresh.equalities) << k;
+      EXPECT_EQ(used.value, fresh.value) << "knot " << k;
+      if (derivatives) {
+        EXPECT_EQ(used.dx, fresh.dx) << "knot " << k;
+        EXPECT_EQ(used.du, fresh.du) << "knot " << k;
+      }
+      for (Eigen::Index row = 0; before.size() == used.value.size() && row < before.size(); ++row) {
+        left_the_margin += before(row) > far && used.value(row) == far ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(left_the_margin, 50);  // the rows the reuse must clear were there
 }
 
 // The smallest signed distance at joint angles q over every pair of shapes of two link frames that

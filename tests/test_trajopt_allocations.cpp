@@ -10,6 +10,7 @@
 #include "diffpills/trajopt/altro.hpp"
 #include "diffpills/trajopt/car.hpp"
 #include "diffpills/trajopt/dynamic_problem.hpp"
+#include "diffpills/trajopt/serial_chain.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace diffpills::trajopt {
@@ -85,6 +86,26 @@ TEST(TrajoptAllocations, FixedSizeIterationsAllocateNothing) {
   std::printf(
       "fixed sizes: %ld allocations for 1 iteration, %ld for %d; run-time sizes: %ld, %ld\n", one,
       many, long_run, dynamic_one, dynamic_many);
+}
+
+// Posing a chain into frames that hold an earlier pose of it allocates nothing (the arm's
+// constraints pose its chain ~100,000 times per solve); into fresh frames it does, so the counter
+// sees these allocations.
+TEST(TrajoptAllocations, ForwardKinematicsIntoUsedFramesAllocatesNothing) {
+  if (!testing::kCountingAllocations) GTEST_SKIP() << "AddressSanitizer owns malloc";
+  const SerialChain chain{{0.0, 0.3, 0.2}, {0.4, 0.0, 0.1}, {0.0, 1.5707963267948966, 0.0}, 0.1};
+  Eigen::Vector3d q(0.1, -0.4, 0.8);
+  ChainFrames frames;
+  const long first = testing::heap_allocations();
+  forward_kinematics(chain, q, true, frames);
+  const long fresh = testing::heap_allocations() - first;
+  EXPECT_GT(fresh, 0);
+  const long before = testing::heap_allocations();
+  for (int i = 0; i < 10; ++i) {
+    q *= 1.1;
+    forward_kinematics(chain, q, i % 2 == 0, frames);
+  }
+  EXPECT_EQ(testing::heap_allocations() - before, 0);
 }
 
 }  // namespace

@@ -107,17 +107,25 @@ Scene arm_shelf_scene(const ArmShelfScenario& scenario) {
   return Scene(std::move(bodies), exclude);
 }
 
+namespace {
+
+// arm_shelf_poses written into frames and poses, reusing their storage.
+void pose_arm(const ArmShelfScenario& scenario, const Eigen::Ref<const Eigen::VectorXd>& q,
+              bool derivatives, trajopt::ChainFrames& frames, std::vector<Pose>& poses) {
+  trajopt::forward_kinematics(scenario.arm.chain, q, derivatives, frames);
+  poses.resize(kLinks + scenario.shelf.size());  // the boards stay at the identity
+  for (std::size_t f = 0; f < static_cast<std::size_t>(kLinks); ++f) {
+    poses[f] = Pose(frames.origin[f], frames.attitude[f]);
+  }
+}
+
+}  // namespace
+
 std::vector<Pose> arm_shelf_poses(const ArmShelfScenario& scenario, const Eigen::VectorXd& q,
                                   trajopt::ChainFrames* frames) {
-  trajopt::ChainFrames chain =
-      trajopt::forward_kinematics(scenario.arm.chain, q, frames != nullptr);
+  trajopt::ChainFrames chain;
   std::vector<Pose> poses;
-  poses.reserve(kLinks + scenario.shelf.size());
-  for (int f = 0; f < kLinks; ++f) {
-    poses.emplace_back(chain.origin[static_cast<std::size_t>(f)],
-                       chain.attitude[static_cast<std::size_t>(f)]);
-  }
-  poses.resize(poses.size() + scenario.shelf.size());
+  pose_arm(scenario, q, frames != nullptr, chain, poses);
   if (frames != nullptr) *frames = std::move(chain);
   return poses;
 }
@@ -128,16 +136,29 @@ ArmShelfProblem::ArmShelfProblem(ArmShelfScenario scenario)
   // link8): the base and the boards never move relative to each other.
   const auto moves = [](int body) { return body >= 1 && body < kLinks; };
   for (int i = 0; i < scene_.size(); ++i) {
+    most_shapes_ = std::max(most_shapes_, static_cast<int>(scene_.body(i).shapes().size()));
+  }
+  row_of_.assign(static_cast<std::size_t>(pair_key(scene_.size(), 0, 0, 0)), -1);
+  for (int i = 0; i < scene_.size(); ++i) {
     for (int j = i + 1; j < scene_.size(); ++j) {
       if (!scene_.checked(i, j) || (!moves(i) && !moves(j))) continue;
       for (int a = 0; a < static_cast<int>(scene_.body(i).shapes().size()); ++a) {
         for (int b = 0; b < static_cast<int>(scene_.body(j).shapes().size()); ++b) {
-          row_of_[{i, j, a, b}] = static_cast<int>(pairs_.size());
+          row_of_[static_cast<std::size_t>(pair_key(i, j, a, b))] = static_cast<int>(pairs_.size());
           pairs_.push_back({i, j, a, b});
         }
       }
     }
   }
+}
+
+int ArmShelfProblem::pair_key(int body_i, int body_j, int shape_a, int shape_b) const {
+  return ((body_i * scene_.size() + body_j) * most_shapes_ + shape_a) * most_shapes_ + shape_b;
+}
+
+int ArmShelfProblem::row_of(const Contact& contact) const {
+  return row_of_[static_cast<std::size_t>(
+      pair_key(contact.bodies[0], contact.bodies[1], contact.shapes[0], contact.shapes[1]))];
 }
 
 void ArmShelfProblem::dynamics(const State& x, const Control& u, State& next, StateMatrix& A,
@@ -170,27 +191,48 @@ ArmShelfProblem::Cost ArmShelfProblem::terminal_cost(const State&) const {
 
 ArmShelfProblem::Constraints ArmShelfProblem::constraints(int k, const State& x,
                                                           const Control& u) const {
-  return evaluate(k, x, u, true);
+  Constraints out;
+  write_constraints(k, x, u, true, out);
+  return out;
 }
 
 ArmShelfProblem::Constraints ArmShelfProblem::constraint_values(int k, const State& x,
                                                                 const Control& u) const {
-  return evaluate(k, x, u, false);
+  Constraints out;
+  write_constraints(k, x, u, false, out);
+  return out;
 }
 
-ArmShelfProblem::Constraints ArmShelfProblem::evaluate(int k, const State& x, const Control& u,
-                                                       bool derivatives) const {
+void ArmShelfProblem::write_constraints(int k, const State& x, const Control& u, bool derivatives,
+                                        Constraints& out) const {
   const bool last = k == knots() - 1;
   const int goals = goal_rows(last), first_collision = collision_start(last);
   const int rows =
       first_collision + (last ? 1 : scenario_.substeps) * static_cast<int>(pairs_.size());
-  Constraints out;
-  out.equalities = goals;
-  out.value.resize(rows);
-  if (derivatives) {
-    out.dx.setZero(rows, 7);
-    out.du.setZero(rows, 7);
+  // A pair more than the margin apart (or not reported by the query) has the constant row
+  // clearance - margin, with zero derivatives.
+  const double far = scenario_.clearance - scenario_.query_margin;
+  // Only a collision row whose value is not `far` has nonzero derivatives, and every result this
+  // function writes keeps that. So where out holds one (of this shape), only those rows are
+  // cleared, not all ~375 x 14 derivatives (that memset cost ~5% of the arm's solve); other
+  // storage is cleared whole, or, for values only, emptied of derivatives that could break it.
+  const bool ours = out.value.size() == rows && out.dx.rows() == rows && out.du.rows() == rows;
+  if (ours) {
+    for (Eigen::Index row = first_collision; row < rows; ++row) {
+      if (out.value(row) == far) continue;
+      out.dx.row(row).setZero();
+      out.du.row(row).setZero();
+    }
+    if (derivatives) {
+      out.dx.topRows(first_collision).setZero();
+      out.du.topRows(first_collision).setZero();
+    }
+  } else {
+    out.value.resize(rows);
+    out.dx.setZero(derivatives ? rows : 0, 7);
+    out.du.setZero(derivatives ? rows : 0, 7);
   }
+  out.equalities = goals;
   const auto& limits = scenario_.arm.joint_limits;
   if (last) {
     out.value.head(7) = x - scenario_.goal;
@@ -212,24 +254,28 @@ ArmShelfProblem::Constraints ArmShelfProblem::evaluate(int k, const State& x, co
     }
   }
   // Collision rows: clearance - min(distance, margin), at the knot and at the substeps between it
-  // and the next knot, q = x + (s / S) dt u. Pairs the query does not report are more than the
-  // margin apart: their row is the constant clearance - margin.
+  // and the next knot, q = x + (s / S) dt u; `far` for the pairs the query does not report.
   const auto pair_count = static_cast<Eigen::Index>(pairs_.size());
-  out.value.tail(rows - first_collision).setConstant(scenario_.clearance - scenario_.query_margin);
+  out.value.tail(rows - first_collision).setConstant(far);
   const int substeps = last ? 1 : scenario_.substeps;
+  // The chain's frames and the scene's poses, kept from call to call by each thread (this runs
+  // ~25,000 times per solve, and posing the chain into fresh storage allocated ~20 vectors and
+  // matrices each time: ~3% of the solve in malloc and free). Nothing is carried over between
+  // calls but capacity: pose_arm overwrites every entry read below.
+  thread_local trajopt::ChainFrames frames;
+  thread_local std::vector<Pose> poses;
   for (int step = 0; step < substeps; ++step) {
     const double fraction = static_cast<double>(step) / scenario_.substeps;
     const State q = last ? x : State(x + fraction * scenario_.dt * u);
-    trajopt::ChainFrames frames;
-    const std::vector<Pose> poses = arm_shelf_poses(scenario_, q, derivatives ? &frames : nullptr);
+    pose_arm(scenario_, q, derivatives, frames, poses);
     const Eigen::Index first_row = first_collision + step * pair_count;
     for (const Contact& contact : scene_.contacts(poses, scenario_.query_margin)) {
-      const auto found = row_of_.find(
-          {contact.bodies[0], contact.bodies[1], contact.shapes[0], contact.shapes[1]});
-      if (found == row_of_.end()) continue;  // two bodies that never move
-      const Eigen::Index row = first_row + found->second;
+      const int pair = row_of(contact);
+      if (pair < 0) continue;  // two bodies that never move
+      const Eigen::Index row = first_row + pair;
       out.value(row) = scenario_.clearance - std::min(contact.distance, scenario_.query_margin);
-      if (!derivatives || contact.distance >= scenario_.query_margin) continue;
+      // No derivatives beyond the margin, nor where the row rounds to `far` (within an ulp of it).
+      if (!derivatives || out.value(row) == far) continue;
       // d distance / dq through the two bodies' frames (the boards and the base do not move),
       // then dq/dx = I and dq/du = (s / S) dt.
       Eigen::Matrix<double, 1, 7> dq = Eigen::Matrix<double, 1, 7>::Zero();
@@ -245,7 +291,6 @@ ArmShelfProblem::Constraints ArmShelfProblem::evaluate(int k, const State& x, co
       if (!last) out.du.row(row) = fraction * scenario_.dt * dq;
     }
   }
-  return out;
 }
 
 Eigen::MatrixXd ArmShelfProblem::dynamics_hessian(const State&, const Control&,
@@ -309,10 +354,9 @@ Eigen::MatrixXd ArmShelfProblem::constraint_hessian(int k, const State& x, const
     trajopt::ChainFrames frames;
     const std::vector<Pose> poses = arm_shelf_poses(scenario_, q, &frames);
     for (const Contact& contact : scene_.contacts(poses, scenario_.query_margin)) {
-      const auto found = row_of_.find(
-          {contact.bodies[0], contact.bodies[1], contact.shapes[0], contact.shapes[1]});
-      if (found == row_of_.end() || contact.distance >= scenario_.query_margin) continue;
-      const double weight = mu(collision_start(last) + step * pair_count + found->second);
+      const int pair = row_of(contact);
+      if (pair < 0 || contact.distance >= scenario_.query_margin) continue;
+      const double weight = mu(collision_start(last) + step * pair_count + pair);
       if (weight == 0.0) continue;
       const Eigen::MatrixXd H_q = -weight * contact_hessian(contact, frames);
       H.topLeftCorner<7, 7>() += H_q;

@@ -37,7 +37,6 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -100,6 +99,9 @@ class ArmShelfProblem : public trajopt::ProblemOf<7, 7> {
   // row per checked shape pair, clearance - min(signed distance, query_margin) <= 0.
   Constraints constraints(int k, const State& x, const Control& u) const override;
   Constraints constraint_values(int k, const State& x, const Control& u) const override;
+  // Both, written into out's storage (problem.hpp): what the solver calls.
+  void write_constraints(int k, const State& x, const Control& u, bool derivatives,
+                         Constraints& out) const override;
   // Exact second derivatives: the dynamics are linear and the cost quadratic; each collision row's
   // Hessian chains signed_distance_hessian through the shapes' poses and the arm's forward
   // kinematics (serial_chain.hpp's attached_pose_derivatives).
@@ -127,14 +129,19 @@ class ArmShelfProblem : public trajopt::ProblemOf<7, 7> {
   std::vector<Eigen::VectorXd> retreat_controls() const;
 
  private:
-  Constraints evaluate(int k, const State& x, const Control& u, bool derivatives) const;
   // The Hessian of a contact's signed distance with respect to the joint angles (7 x 7).
   Eigen::MatrixXd contact_hessian(const Contact& contact, const trajopt::ChainFrames& frames) const;
+  // A contact's collision row among the pairs, or -1 for two bodies that never move: row_of_
+  // holds it at pair_key(bodies, shapes) (bodies i < j, as the scene reports them), a flat table
+  // (a std::map lookup per contact cost ~2% of the arm's solve).
+  int row_of(const Contact& contact) const;
+  int pair_key(int body_i, int body_j, int shape_a, int shape_b) const;
 
   ArmShelfScenario scenario_;
   Scene scene_;
   std::vector<std::array<int, 4>> pairs_;
-  std::map<std::array<int, 4>, int> row_of_;
+  int most_shapes_ = 0;  // the most shapes a body has
+  std::vector<int> row_of_;
 };
 
 // The smallest signed distance over the checked pairs at joint angles q (every pair, not only

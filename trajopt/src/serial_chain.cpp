@@ -27,8 +27,15 @@ Eigen::Vector4d product(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
 
 }  // namespace
 
-ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::VectorXd& q,
+ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q,
                                bool derivatives) {
+  ChainFrames frames;
+  forward_kinematics(chain, q, derivatives, frames);
+  return frames;
+}
+
+void forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q,
+                        bool derivatives, ChainFrames& out) {
   const int n = chain.joints();
   if (static_cast<int>(chain.d.size()) != n || static_cast<int>(chain.alpha.size()) != n) {
     throw std::invalid_argument("chain: a, d and alpha must have one entry per joint");
@@ -37,11 +44,11 @@ ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::VectorXd& 
     throw std::invalid_argument("q: expected " + std::to_string(n) + " joint angles, got " +
                                 std::to_string(q.size()));
   }
-  ChainFrames out;
-  out.origin.assign(static_cast<std::size_t>(n) + 2, Eigen::Vector3d::Zero());
-  out.attitude.assign(static_cast<std::size_t>(n) + 2, Eigen::Vector4d(1, 0, 0, 0));
+  const auto frames = static_cast<std::size_t>(n) + 2;
+  out.origin.assign(frames, Eigen::Vector3d::Zero());
+  out.attitude.assign(frames, Eigen::Vector4d(1, 0, 0, 0));
   std::vector<Eigen::Vector3d>& axis = out.axis;
-  axis.assign(static_cast<std::size_t>(n) + 1, Eigen::Vector3d::Zero());
+  axis.assign(frames - 1, Eigen::Vector3d::Zero());
   for (int i = 1; i <= n + 1; ++i) {
     const auto f = static_cast<std::size_t>(i);
     const Eigen::Matrix3d previous = rotation_matrix(out.attitude[f - 1]);
@@ -56,11 +63,14 @@ ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::VectorXd& 
       out.origin[f] = out.origin[f - 1] + chain.flange_d * previous.col(2);
     }
   }
-  if (!derivatives) return out;
-  out.d_origin.assign(static_cast<std::size_t>(n) + 2,
-                      Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, n));
-  out.d_attitude.assign(static_cast<std::size_t>(n) + 2,
-                        Eigen::Matrix<double, 4, Eigen::Dynamic>::Zero(4, n));
+  if (!derivatives) return;
+  // resize and setZero, not assign(count, Zero(3, n)): that builds its argument on the heap.
+  out.d_origin.resize(frames);
+  out.d_attitude.resize(frames);
+  for (std::size_t f = 0; f < frames; ++f) {
+    out.d_origin[f].setZero(3, n);
+    out.d_attitude[f].setZero(4, n);
+  }
   for (int f = 1; f <= n + 1; ++f) {
     const auto frame = static_cast<std::size_t>(f);
     for (int j = 1; j <= std::min(f, n); ++j) {
@@ -71,7 +81,6 @@ ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::VectorXd& 
           0.5 * product(Eigen::Vector4d(0.0, z.x(), z.y(), z.z()), out.attitude[frame]);
     }
   }
-  return out;
 }
 
 AttachedPoseDerivatives attached_pose_derivatives(const ChainFrames& frames, int frame,

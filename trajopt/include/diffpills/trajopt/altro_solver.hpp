@@ -1,7 +1,8 @@
 // The ALTRO-style solver of altro.hpp, a template over the problem's state and control sizes
 // (problem.hpp). With fixed sizes every state, control, Jacobian, gain and cost expansion is an
 // Eigen fixed-size object: the backward pass, the rollouts and the line search allocate nothing
-// but the constraint rows the problem returns (a run-time count), and Eigen unrolls the small
+// but the constraint rows the problem returns (a run-time count; none once they are sized, for a
+// problem that writes them in place through write_constraints), and Eigen unrolls the small
 // products. With Eigen::Dynamic the same code runs on VectorXd and MatrixXd.
 //
 // Included by altro.hpp; use trajopt::solve, not this class.
@@ -198,8 +199,7 @@ const std::vector<typename AltroSolver<Nx, Nu>::Constraints>& AltroSolver<Nx, Nu
   }
   r.c.resize(n_);
   for (int k = 0; k < n_; ++k) {
-    r.c[k] = derivatives ? problem_.constraints(k, r.x[k], control(r, k))
-                         : problem_.constraint_values(k, r.x[k], control(r, k));
+    problem_.write_constraints(k, r.x[k], control(r, k), derivatives, r.c[k]);
     check_rows(r.c[k], k, derivatives);
   }
   r.evaluated = derivatives ? Evaluated::kDerivatives : Evaluated::kValues;
@@ -543,7 +543,7 @@ AltroResult AltroSolver<Nx, Nu>::run(const Eigen::VectorXd& x0,
   lambda_.resize(n_);
   r.c.resize(n_);
   for (int k = 0; k < n_; ++k) {  // the first call fixes each knot's row count
-    r.c[k] = problem_.constraints(k, r.x[k], control(r, k));
+    problem_.write_constraints(k, r.x[k], control(r, k), true, r.c[k]);
     lambda_[k] = Eigen::VectorXd::Zero(r.c[k].value.size());
     check_rows(r.c[k], k, true);
   }

@@ -103,6 +103,18 @@ class ProblemOf {
     return constraints(k, x, u);
   }
 
+  // What ALTRO calls: constraints (derivatives true) or constraint_values (false) at knot k,
+  // written into `out`, which is empty or holds what an earlier write_constraints of this problem
+  // left there (at any knot, with or without derivatives). The default assigns the function's
+  // result. A problem with many rows overrides it to write them into out's storage, which then
+  // lives as long as the solve: the arm's ~375 rows of value, dx and du were allocated and freed
+  // at every knot of every sweep. An override must write what the function would; with
+  // derivatives false, dx and du are not read and may hold anything.
+  virtual void write_constraints(int k, const State& x, const Control& u, bool derivatives,
+                                 Constraints& out) const {
+    out = derivatives ? constraints(k, x, u) : constraint_values(k, x, u);
+  }
+
   // Second derivatives. A problem that returns true here implements the two functions below, and
   // its cost expansions' Hessians are exact (not Gauss-Newton); the defaults have none and throw
   // std::logic_error.

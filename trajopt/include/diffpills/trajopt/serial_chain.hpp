@@ -50,8 +50,13 @@ struct ChainFrames {
 };
 
 // Throws std::invalid_argument if the parameter lists differ in length or q does not match them.
-ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::VectorXd& q,
+ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q,
                                bool derivatives = true);
+// The same, written into `frames`, whose storage is reused: nothing is allocated when frames holds
+// an earlier call's result for this chain (for loops that pose the chain many times). Without
+// `derivatives`, frames' d_origin and d_attitude are left as they were.
+void forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q,
+                        bool derivatives, ChainFrames& frames);
 
 // For a pose (p, q_p) fixed in frame f (frames from forward_kinematics at q, 0 <= f <= n + 1):
 // its Jacobian with respect to q (7 x n, rows [p; q_p]), and sum_k gradient_k d2 pose_k / dq2
