@@ -68,21 +68,32 @@ TEST(ArmShelf, ForwardKinematicsIsTheDhProduct) {
   EXPECT_NEAR(rotation_matrix(frames.attitude[8]).col(2).z(), -1.0, 1e-12);
 }
 
-// Posing the chain into the frames of another configuration (the in-place forward_kinematics,
-// which reuses their storage) gives the frames posed into fresh storage, bit for bit.
+// Posing a chain into the frames of another configuration, or of another chain (the in-place
+// forward_kinematics, which reuses their storage) gives the frames posed into fresh storage, bit
+// for bit; without derivatives, the Jacobians it keeps are this chain's sizes, or none.
 TEST(ArmShelf, ForwardKinematicsIntoUsedFramesEqualsFresh) {
   const PandaArm arm = panda_arm();
+  trajopt::SerialChain shoulder = arm.chain;  // the Panda's first three joints
+  for (std::vector<double>* list : {&shoulder.a, &shoulder.d, &shoulder.alpha}) list->resize(3);
   std::mt19937_64 rng(4);
   trajopt::ChainFrames used;
-  for (int trial = 0; trial < 50; ++trial) {
-    const Eigen::VectorXd q = random_joints(rng, arm);
+  for (int trial = 0; trial < 60; ++trial) {
+    const bool short_chain = trial % 4 == 3 || trial % 5 == 4;
+    const trajopt::SerialChain& chain = short_chain ? shoulder : arm.chain;
+    const Eigen::VectorXd q = random_joints(rng, arm).head(chain.joints());
     const bool derivatives = trial % 3 != 1;
-    trajopt::forward_kinematics(arm.chain, q, derivatives, used);
-    const trajopt::ChainFrames fresh = trajopt::forward_kinematics(arm.chain, q, derivatives);
+    trajopt::forward_kinematics(chain, q, derivatives, used);
+    const trajopt::ChainFrames fresh = trajopt::forward_kinematics(chain, q, derivatives);
     EXPECT_EQ(used.origin, fresh.origin);
     EXPECT_EQ(used.attitude, fresh.attitude);
     EXPECT_EQ(used.axis, fresh.axis);
-    if (!derivatives) continue;
+    if (!derivatives) {
+      EXPECT_TRUE(used.d_origin.empty() || (used.d_origin.size() == fresh.origin.size() &&
+                                            used.d_origin[0].cols() == chain.joints()))
+          << trial;
+      EXPECT_EQ(used.d_attitude.size(), used.d_origin.size()) << trial;
+      continue;
+    }
     ASSERT_EQ(used.d_origin.size(), fresh.d_origin.size());
     for (std::size_t f = 0; f < fresh.d_origin.size(); ++f) {
       EXPECT_EQ(used.d_origin[f], fresh.d_origin[f]) << f;

@@ -24,6 +24,7 @@
 #include "demo_json.hpp"
 #include "diffpills/diffpills.hpp"
 #include "json_io.hpp"
+#include "solver_runs.hpp"
 
 namespace {
 
@@ -296,6 +297,7 @@ TEST(DemoOutputs, IpoptComparison) {
     const nlohmann::json& run = car_bus.at(key);
     EXPECT_EQ(run["hessian"], hessian);
     EXPECT_EQ(run["status"], "solved");
+    EXPECT_EQ(run["max_cpu_seconds"], 120.0);  // the default limit
     EXPECT_LE(run["max_violation"].get<double>(), 1e-6);
     EXPECT_NEAR(run["cost"].get<double>(), altro_cost, 1e-3 * altro_cost) << key;
     if (run["solve_ms"].get<double>() < faster) {
@@ -340,7 +342,8 @@ TEST(DemoOutputs, IpoptCpuLimitStopsTheRunsAndIsReported) {
   const std::string row_text = printed.substr(row + 1, printed.find('\n', row + 1) - row - 1);
   EXPECT_EQ(row_text.find("solved"), row_text.rfind("solved")) << row_text;  // ALTRO's only
   EXPECT_NE(row_text.find("failed"), row_text.rfind("failed")) << row_text;  // both Ipopt runs
-  EXPECT_NE(printed.find("each run stopped after 1e-09 s of CPU time"), std::string::npos);
+  EXPECT_NE(printed.find("each run limited to 1e-09 s of CPU time"), std::string::npos);
+  EXPECT_EQ(car_bus["ipopt"]["max_cpu_seconds"], 1e-9);
 }
 
 // An Ipopt block writes null for the cost and the violation of a run that handed back no point
@@ -363,6 +366,35 @@ TEST(DemoOutputs, IpoptBlockWithoutAPointHasNullCostAndViolation) {
   EXPECT_EQ(with_point["max_violation"], 0.25);
 }
 
+// Of each Hessian's runs the demo keeps the fastest that solved, not a faster one stopped by the
+// CPU limit (its wall time can be shorter), and the fastest of all when none solved.
+TEST(DemoOutputs, FastestIpoptKeepsTheFastestSolvedRun) {
+  using diffpills::examples::IpoptHessian;
+  using diffpills::examples::IpoptRun;
+  const auto run = [](bool solved, double ms) {
+    IpoptRun r;
+    r.solved = solved;
+    r.solve_ms = ms;
+    return r;
+  };
+  // Limited-memory: stopped at 100 ms, solved at 130 and 120; exact: stopped at 90 and 80.
+  const std::vector<IpoptRun> limited = {run(false, 100), run(true, 130), run(true, 120)};
+  const std::vector<IpoptRun> exact = {run(false, 90), run(false, 80), run(false, 95)};
+  std::size_t next_limited = 0, next_exact = 0;
+  const diffpills::examples::IpoptRuns kept =
+      diffpills::examples::fastest_ipopt(3, [&](IpoptHessian hessian) {
+        IpoptRun r =
+            hessian == IpoptHessian::kExact ? exact.at(next_exact++) : limited.at(next_limited++);
+        r.hessian = hessian;
+        return r;
+      });
+  EXPECT_TRUE(kept.limited_memory.solved);
+  EXPECT_EQ(kept.limited_memory.solve_ms, 120.0);
+  EXPECT_FALSE(kept.exact.solved);
+  EXPECT_EQ(kept.exact.solve_ms, 80.0);
+  EXPECT_EQ(kept.faster_solved(), &kept.limited_memory);
+}
+
 // The demo's command line: --help, a stray or second argument, and a folder it cannot write
 // (an existing one: /proc) end with the documented statuses, not a silent success; so does an
 // --ipopt-cpu-seconds without a finite positive number of seconds.
@@ -376,7 +408,9 @@ TEST(DemoOutputs, CommandLine) {
   EXPECT_EQ(status("-q"), 2);
   EXPECT_EQ(status("one two --quick"), 2);
   EXPECT_EQ(status("/proc --quick"), 1);
-  for (const char* limit : {"", "0", "-1", "nan", "inf", "1e999", "abc", "5s", "--quick"}) {
+  EXPECT_EQ(status("--quick --ipopt-cpu-seconds"), 2);  // no value
+  for (const char* limit : {"''", "0", "-0", "-1", "nan", "inf", "1e999", "1e-400", "1e-310", "abc",
+                            "5s", "' 5'", "'5 '", "--quick"}) {
     EXPECT_EQ(status(std::string("--quick --ipopt-cpu-seconds ") + limit), 2) << limit;
   }
 }

@@ -49,6 +49,37 @@ class CarToAPoint : public ProblemOf<5, 2> {
   State goal_ = (State() << 10.0, 3.0, 0.0, 0.0, 0.0).finished();
 };
 
+// CarToAPoint with its speed (state 3) held within +-3 m/s: two inequality rows per knot, each
+// evaluation into fresh storage (the default write_constraints assigns what constraints returns).
+class SpeedLimitedCar : public CarToAPoint {
+ public:
+  Constraints constraints(int, const State& x, const Control&) const override {
+    Constraints rows;
+    write_rows(x, rows);
+    return rows;
+  }
+
+ protected:
+  static void write_rows(const State& x, Constraints& rows) {
+    rows.value.resize(2);
+    rows.dx.setZero(2, 5);
+    rows.du.setZero(2, 2);
+    rows.value << x(3) - 3.0, -x(3) - 3.0;
+    rows.dx(0, 3) = 1.0;
+    rows.dx(1, 3) = -1.0;
+    rows.equalities = 0;
+  }
+};
+
+// The same rows written into the solver's storage.
+class SpeedLimitedCarInPlace : public SpeedLimitedCar {
+ public:
+  void write_constraints(int, const State& x, const Control&, bool,
+                         Constraints& out) const override {
+    write_rows(x, out);
+  }
+};
+
 // Allocations of one solve capped at `iterations` iLQR iterations (the polish, which builds sparse
 // matrices, off).
 template <class Problem>
@@ -88,8 +119,26 @@ TEST(TrajoptAllocations, FixedSizeIterationsAllocateNothing) {
       many, long_run, dynamic_one, dynamic_many);
 }
 
+// A problem that writes its constraint rows in place (write_constraints) makes the solver's
+// iterations allocate nothing; the same rows returned fresh by constraints() allocate per sweep.
+TEST(TrajoptAllocations, ConstraintsWrittenInPlaceAllocateNothingPerIteration) {
+  if (!testing::kCountingAllocations) GTEST_SKIP() << "AddressSanitizer owns malloc";
+  const SpeedLimitedCarInPlace in_place;
+  const SpeedLimitedCar fresh;
+  int short_run = 0, long_run = 0;
+  allocations_of_solve(in_place, 1000, &long_run);  // warm-up, as above
+  const long one = allocations_of_solve(in_place, 1, &short_run);
+  const long many = allocations_of_solve(in_place, 1000, &long_run);
+  ASSERT_EQ(short_run, 1);
+  ASSERT_GE(long_run, 5);
+  EXPECT_EQ(many, one) << long_run << " iterations";
+  const long fresh_one = allocations_of_solve(fresh, 1, &short_run);
+  const long fresh_many = allocations_of_solve(fresh, 1000, &long_run);
+  EXPECT_GT(fresh_many, fresh_one + long_run);
+}
+
 // Posing a chain into frames that hold an earlier pose of it allocates nothing (the arm's
-// constraints pose its chain ~100,000 times per solve); into fresh frames it does, so the counter
+// constraints pose its chain ~21,000 times per solve); into fresh frames it does, so the counter
 // sees these allocations.
 TEST(TrajoptAllocations, ForwardKinematicsIntoUsedFramesAllocatesNothing) {
   if (!testing::kCountingAllocations) GTEST_SKIP() << "AddressSanitizer owns malloc";

@@ -152,6 +152,10 @@ ArmShelfProblem::ArmShelfProblem(ArmShelfScenario scenario)
   }
 }
 
+double ArmShelfProblem::collision_row(double distance) const {
+  return scenario_.clearance - std::min(distance, scenario_.query_margin);
+}
+
 int ArmShelfProblem::pair_key(int body_i, int body_j, int shape_a, int shape_b) const {
   return ((body_i * scene_.size() + body_j) * most_shapes_ + shape_a) * most_shapes_ + shape_b;
 }
@@ -209,12 +213,12 @@ void ArmShelfProblem::write_constraints(int k, const State& x, const Control& u,
   const int goals = goal_rows(last), first_collision = collision_start(last);
   const int rows =
       first_collision + (last ? 1 : scenario_.substeps) * static_cast<int>(pairs_.size());
-  // A pair more than the margin apart (or not reported by the query) has the constant row
-  // clearance - margin, with zero derivatives.
-  const double far = scenario_.clearance - scenario_.query_margin;
+  // A pair the margin or more apart (or not reported by the query) has the constant row `far`,
+  // with zero derivatives.
+  const double far = far_row();
   // Only a collision row whose value is not `far` has nonzero derivatives, and every result this
   // function writes keeps that. So where out holds one (of this shape), only those rows are
-  // cleared, not all ~375 x 14 derivatives (that memset cost ~5% of the arm's solve); other
+  // cleared, not all ~375 x 14 derivatives (that memset was 2-5% of the arm's solve); other
   // storage is cleared whole, or, for values only, emptied of derivatives that could break it.
   const bool ours = out.value.size() == rows && out.dx.rows() == rows && out.du.rows() == rows;
   if (ours) {
@@ -258,9 +262,9 @@ void ArmShelfProblem::write_constraints(int k, const State& x, const Control& u,
   const auto pair_count = static_cast<Eigen::Index>(pairs_.size());
   out.value.tail(rows - first_collision).setConstant(far);
   const int substeps = last ? 1 : scenario_.substeps;
-  // The chain's frames and the scene's poses, kept from call to call by each thread (this runs
-  // ~25,000 times per solve, and posing the chain into fresh storage allocated ~20 vectors and
-  // matrices each time: ~3% of the solve in malloc and free). Nothing is carried over between
+  // The chain's frames and the scene's poses, kept from call to call by each thread (a solve makes
+  // ~5,400 calls and ~21,000 poses, and posing the chain into fresh storage allocated ~20 vectors
+  // and matrices each time: ~3% of the solve in malloc and free). Nothing is carried over between
   // calls but capacity: pose_arm overwrites every entry read below.
   thread_local trajopt::ChainFrames frames;
   thread_local std::vector<Pose> poses;
@@ -273,8 +277,7 @@ void ArmShelfProblem::write_constraints(int k, const State& x, const Control& u,
       const int pair = row_of(contact);
       if (pair < 0) continue;  // two bodies that never move
       const Eigen::Index row = first_row + pair;
-      out.value(row) = scenario_.clearance - std::min(contact.distance, scenario_.query_margin);
-      // No derivatives beyond the margin, nor where the row rounds to `far` (within an ulp of it).
+      out.value(row) = collision_row(contact.distance);
       if (!derivatives || out.value(row) == far) continue;
       // d distance / dq through the two bodies' frames (the boards and the base do not move),
       // then dq/dx = I and dq/du = (s / S) dt.
@@ -355,7 +358,7 @@ Eigen::MatrixXd ArmShelfProblem::constraint_hessian(int k, const State& x, const
     const std::vector<Pose> poses = arm_shelf_poses(scenario_, q, &frames);
     for (const Contact& contact : scene_.contacts(poses, scenario_.query_margin)) {
       const int pair = row_of(contact);
-      if (pair < 0 || contact.distance >= scenario_.query_margin) continue;
+      if (pair < 0 || collision_row(contact.distance) == far_row()) continue;
       const double weight = mu(collision_start(last) + step * pair_count + pair);
       if (weight == 0.0) continue;
       const Eigen::MatrixXd H_q = -weight * contact_hessian(contact, frames);

@@ -32,9 +32,13 @@ nlohmann::ordered_json ipopt_summary(const IpoptRun& run) {
   const auto of_point = [&run](double value) {
     return run.has_point() ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
   };
-  return {{"hessian", to_string(run.hessian)}, {"status", run.status},
-          {"iterations", run.iterations},      {"max_violation", of_point(run.max_violation)},
-          {"cost", of_point(run.cost)},        {"solve_ms", run.solve_ms}};
+  return {{"hessian", to_string(run.hessian)},
+          {"status", run.status},
+          {"iterations", run.iterations},
+          {"max_violation", of_point(run.max_violation)},
+          {"cost", of_point(run.cost)},
+          {"solve_ms", run.solve_ms},
+          {"max_cpu_seconds", run.max_cpu_seconds}};
 }
 
 }  // namespace diffpills::examples

@@ -23,7 +23,8 @@ nlohmann::ordered_json json_list(const Eigen::VectorXd& v);
 nlohmann::ordered_json altro_summary(const trajopt::AltroResult& result, double solve_ms);
 
 // An Ipopt block: hessian ("limited-memory" or "exact"), status, iterations, max_violation, cost
-// (both null when Ipopt handed back no point: IpoptRun::has_point) and solve_ms.
+// (both null when Ipopt handed back no point: IpoptRun::has_point), solve_ms and max_cpu_seconds
+// (the run's CPU limit).
 nlohmann::ordered_json ipopt_summary(const IpoptRun& run);
 
 }  // namespace diffpills::examples

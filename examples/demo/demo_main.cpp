@@ -11,6 +11,8 @@
 // seconds of CPU time (default 120; DemoSettings).
 #include <Eigen/Geometry>
 #include <array>
+#include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -18,6 +20,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
@@ -264,11 +267,17 @@ void print_unsolved(const std::string& name, const std::optional<examples::Ipopt
   }
 }
 
-// text as a finite number > 0, all of it read ("120", "1e-9"), or nothing.
-std::optional<double> positive_number(const char* text) {
+// text as a number of seconds, all of it read ("120", "1e-9"), in double's normal range
+// [2.2e-308, 1.8e308] and > 0, or nothing. Not text with leading white space (strtod skips it;
+// trailing space is not read either), nor a number strtod cannot hold: it turns 1e-400 into 0,
+// 1e400 into infinity (both ERANGE), and 1e-310 into a subnormal that has lost digits.
+std::optional<double> seconds_limit(const char* text) {
+  if (std::isspace(static_cast<unsigned char>(text[0])) != 0) return std::nullopt;
   char* end = nullptr;
+  errno = 0;
   const double value = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !std::isfinite(value) || !(value > 0.0)) return std::nullopt;
+  const bool normal = std::isfinite(value) && value >= std::numeric_limits<double>::min();
+  if (end == text || *end != '\0' || errno == ERANGE || !normal) return std::nullopt;
   return value;
 }
 
@@ -278,21 +287,27 @@ int run(int argc, char** argv) {
   bool folder_given = false;
   constexpr const char* kUsage =
       "usage: diffpills_demo [output folder, default out] [--quick] [--ipopt-cpu-seconds S]\n";
+  constexpr const char* kHelp =
+      "  --quick                 each solver once, Ipopt on the car-bus problem only\n"
+      "  --ipopt-cpu-seconds S   stop each Ipopt run after S seconds of CPU time (a finite\n"
+      "                          number > 0 in double's normal range; default 120)\n"
+      "exit status: 0 done, 1 a file not written or a problem not solved by ALTRO (a solver's\n"
+      "error too), 2 a bad argument\n";
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
     if (argument == "--quick") {
       settings.quick = true;
     } else if (argument == "--ipopt-cpu-seconds") {
-      const std::optional<double> seconds =
-          i + 1 < argc ? positive_number(argv[++i]) : std::nullopt;
+      const std::optional<double> seconds = i + 1 < argc ? seconds_limit(argv[++i]) : std::nullopt;
       if (!seconds) {
-        std::cerr << "diffpills_demo: --ipopt-cpu-seconds needs a positive number of seconds\n"
+        std::cerr << "diffpills_demo: --ipopt-cpu-seconds needs a finite number of seconds > 0 in "
+                     "double's normal range\n"
                   << kUsage;
         return 2;
       }
       settings.ipopt_cpu_seconds = *seconds;
     } else if (argument == "--help" || argument == "-h") {
-      std::cout << kUsage;
+      std::cout << kUsage << kHelp;
       return 0;
     } else if (argument.empty() || argument[0] == '-' || folder_given) {
       std::cerr << "diffpills_demo: unexpected argument '" << argument << "'\n" << kUsage;
@@ -342,8 +357,7 @@ int run(int argc, char** argv) {
   print_unsolved("arm_shelf", reach.ipopt);
   std::cout << "\nALTRO and Ipopt from the same guess; the fastest run of " << run.runs
             << " per solver (the arm: " << reach.runs
-            << "); Ipopt with its limited-memory (L-M) and its exact Hessian, each run stopped "
-               "after "
+            << "); Ipopt with its limited-memory (L-M) and its exact Hessian, each run limited to "
             << settings.ipopt_cpu_seconds
             << " s of CPU time; speed-up: the faster solved Ipopt's time over ALTRO's (*: that "
                "Ipopt run stopped at another local minimum, its cost more than 1% from ALTRO's)\n";

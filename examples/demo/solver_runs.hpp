@@ -44,7 +44,8 @@ struct IpoptRuns {
   // The faster of the runs that solved, or nullptr if neither did.
   const IpoptRun* faster_solved() const;
 };
-// solve(hessian) runs Ipopt once with that Hessian.
+// solve(hessian) runs Ipopt once with that Hessian; each Hessian's fastest solved run of `runs`,
+// or its fastest run if none solved.
 IpoptRuns fastest_ipopt(int runs, const std::function<IpoptRun(IpoptHessian)>& solve);
 
 // Whether two solvers' costs are one local minimum's (within 1%): a speed-up between different

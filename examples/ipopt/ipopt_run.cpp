@@ -77,6 +77,7 @@ IpoptRun solve_timed(const Ipopt::SmartPtr<Ipopt::TNLP>& nlp, const IpoptRun& re
   IpoptRun run = result;
   run.hessian = hessian;
   run.solve_ms = solve_ms;
+  run.max_cpu_seconds = max_cpu_seconds;
   run.status = ipopt_status_text(status);
   if (Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics(); IsValid(statistics)) {
     run.iterations = statistics->IterationCount();

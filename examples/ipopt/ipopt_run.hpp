@@ -37,6 +37,7 @@ struct IpoptRun {
   double cost = 0.0;
   double max_violation = 0.0;  // the largest dynamics defect or constraint violation
   double solve_ms = 0.0;
+  double max_cpu_seconds = kNoIpoptTimeLimit;  // the run's CPU limit (Ipopt's max_cpu_time)
   std::vector<Eigen::VectorXd> states, controls;
   // Whether Ipopt handed back its last point (its finalize_solution, which it skips for errors
   // before it starts, such as an option out of range): the cost, max_violation, states and

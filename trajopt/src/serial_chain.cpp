@@ -63,7 +63,17 @@ void forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::
       out.origin[f] = out.origin[f - 1] + chain.flange_d * previous.col(2);
     }
   }
-  if (!derivatives) return;
+  if (!derivatives) {
+    // An earlier call's derivatives are kept for their storage, but not another chain's, whose
+    // sizes a reader would take for this one's.
+    const bool fits = out.d_origin.size() == frames && out.d_attitude.size() == frames &&
+                      (frames == 0 || out.d_origin[0].cols() == n);
+    if (!fits) {
+      out.d_origin.clear();
+      out.d_attitude.clear();
+    }
+    return;
+  }
   // resize and setZero, not assign(count, Zero(3, n)): that builds its argument on the heap.
   out.d_origin.resize(frames);
   out.d_attitude.resize(frames);

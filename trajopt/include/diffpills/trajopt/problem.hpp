@@ -109,7 +109,9 @@ class ProblemOf {
   // result. A problem with many rows overrides it to write them into out's storage, which then
   // lives as long as the solve: the arm's ~375 rows of value, dx and du were allocated and freed
   // at every knot of every sweep. An override must write what the function would; with
-  // derivatives false, dx and du are not read and may hold anything.
+  // derivatives false, dx and du are not read and may hold anything. ALTRO then calls only the
+  // override: a class derived from such a problem that changes constraints() or
+  // constraint_values() must override write_constraints too.
   virtual void write_constraints(int k, const State& x, const Control& u, bool derivatives,
                                  Constraints& out) const {
     out = derivatives ? constraints(k, x, u) : constraint_values(k, x, u);

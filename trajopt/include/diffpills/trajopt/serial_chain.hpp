@@ -53,8 +53,9 @@ struct ChainFrames {
 ChainFrames forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q,
                                bool derivatives = true);
 // The same, written into `frames`, whose storage is reused: nothing is allocated when frames holds
-// an earlier call's result for this chain (for loops that pose the chain many times). Without
-// `derivatives`, frames' d_origin and d_attitude are left as they were.
+// an earlier call's result for this chain with derivatives, or for any call without them (for
+// loops that pose the chain many times). Without `derivatives`, frames' d_origin and d_attitude
+// keep an earlier call's Jacobians for this chain (stale: not at q) or are emptied.
 void forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::VectorXd>& q,
                         bool derivatives, ChainFrames& frames);
 
