@@ -67,7 +67,7 @@ void forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::
     // An earlier call's derivatives are kept for their storage, but not another chain's, whose
     // sizes a reader would take for this one's.
     const bool fits = out.d_origin.size() == frames && out.d_attitude.size() == frames &&
-                      (frames == 0 || out.d_origin[0].cols() == n);
+                      out.d_origin[0].cols() == n;  // frames >= 2: the base and the flange
     if (!fits) {
       out.d_origin.clear();
       out.d_attitude.clear();
