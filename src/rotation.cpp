@@ -6,8 +6,9 @@
 
 namespace diffpills {
 
+// The same bits as UnitQuaternion(q).matrix(), without its derivative map.
 Eigen::Matrix3d rotation_matrix(const Eigen::Vector4d& q) {
-  return detail::UnitQuaternion(q).matrix();
+  return detail::unit_rotation_matrix(q * (1.0 / q.norm()));
 }
 
 Eigen::Matrix<double, 3, 4> rotate_jacobian(const Eigen::Vector4d& q, const Eigen::Vector3d& v) {

@@ -10,25 +10,31 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& u) {
   return m;
 }
 
-// Q = I + 2 w [v]x + 2 [v]x^2 for the unit quaternion [w, v], written out entry by entry
-// (e.g. Q00 = 1 - 2 (y^2 + z^2), Q01 = 2 (x y - w z)); G = L(q) [0; I3] with
-// L(q) = [w -v'; v w I + [v]x].
-UnitQuaternion::UnitQuaternion(const Eigen::Vector4d& q) {
-  inverse_norm_ = 1.0 / q.norm();  // one square root, one division
-  const double inverse_norm = inverse_norm_;
-  unit_ = q * inverse_norm;
+// Q = I + 2 w [v]x + 2 [v]x^2, written out entry by entry (e.g. Q00 = 1 - 2 (y^2 + z^2),
+// Q01 = 2 (x y - w z)): it runs for every body of a scene query, and Eigen's comma initializer
+// costs more.
+Eigen::Matrix3d unit_rotation_matrix(const Eigen::Vector4d& u) {
+  const double w = u(0), x = u(1), y = u(2), z = u(3);
+  Eigen::Matrix3d Q;
+  Q(0, 0) = 1.0 - 2.0 * (y * y + z * z);
+  Q(0, 1) = 2.0 * (x * y - w * z);
+  Q(0, 2) = 2.0 * (x * z + w * y);
+  Q(1, 0) = 2.0 * (x * y + w * z);
+  Q(1, 1) = 1.0 - 2.0 * (x * x + z * z);
+  Q(1, 2) = 2.0 * (y * z - w * x);
+  Q(2, 0) = 2.0 * (x * z - w * y);
+  Q(2, 1) = 2.0 * (y * z + w * x);
+  Q(2, 2) = 1.0 - 2.0 * (x * x + y * y);
+  return Q;
+}
+
+// G = L(q) [0; I3] with L(q) = [w -v'; v w I + [v]x], the unit quaternion's.
+UnitQuaternion::UnitQuaternion(const Eigen::Vector4d& q)
+    : inverse_norm_(1.0 / q.norm()) {  // one square root, one division
+  unit_ = q * inverse_norm_;
+  matrix_ = unit_rotation_matrix(unit_);
   const double w = unit_(0), x = unit_(1), y = unit_(2), z = unit_(3);
-  // Element by element: this runs twice per query, and Eigen's comma initializer costs more.
-  matrix_(0, 0) = 1.0 - 2.0 * (y * y + z * z);
-  matrix_(0, 1) = 2.0 * (x * y - w * z);
-  matrix_(0, 2) = 2.0 * (x * z + w * y);
-  matrix_(1, 0) = 2.0 * (x * y + w * z);
-  matrix_(1, 1) = 1.0 - 2.0 * (x * x + z * z);
-  matrix_(1, 2) = 2.0 * (y * z - w * x);
-  matrix_(2, 0) = 2.0 * (x * z - w * y);
-  matrix_(2, 1) = 2.0 * (y * z + w * x);
-  matrix_(2, 2) = 1.0 - 2.0 * (x * x + y * y);
-  const double g = 2.0 * inverse_norm;
+  const double g = 2.0 * inverse_norm_;
   theta_to_q_(0, 0) = -g * x, theta_to_q_(0, 1) = -g * y, theta_to_q_(0, 2) = -g * z;
   theta_to_q_(1, 0) = g * w, theta_to_q_(1, 1) = -g * z, theta_to_q_(1, 2) = g * y;
   theta_to_q_(2, 0) = g * z, theta_to_q_(2, 1) = g * w, theta_to_q_(2, 2) = -g * x;

@@ -1,5 +1,5 @@
 // A quaternion normalized once, for code that rotates and differentiates with the same attitude
-// several times per query. The public functions of rotation.hpp are thin wrappers around it.
+// several times per query. The rotating functions of rotation.hpp are thin wrappers around it.
 #pragma once
 
 #include <Eigen/Core>
@@ -8,6 +8,9 @@ namespace diffpills::detail {
 
 // [u]x, the cross-product matrix: [u]x v = u x v.
 Eigen::Matrix3d skew(const Eigen::Vector3d& u);
+
+// Q(u) for a unit quaternion u (not normalized again): Q = I + 2 w [v]x + 2 [v]x^2 for u = [w, v].
+Eigen::Matrix3d unit_rotation_matrix(const Eigen::Vector4d& u);
 
 // Derivatives go through the body-frame rotation vector theta of the perturbation
 // q (x) exp(theta). For unit q, dq = 1/2 G(q) dtheta with G = L(q) [0; I3] (4x3) and G'G = I, so
@@ -22,6 +25,8 @@ class UnitQuaternion {
   explicit UnitQuaternion(const Eigen::Vector4d& q);
 
   const Eigen::Vector4d& unit() const { return unit_; }
+  // 1 / |q| of the q given.
+  double inverse_norm() const { return inverse_norm_; }
   // Q(q / |q|).
   const Eigen::Matrix3d& matrix() const { return matrix_; }
   // d/dq [ Q(q / |q|) u ] (3x4), and d/dq [ Q(q / |q|)' v ].

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "diffpills/rotation.hpp"
+#include "unit_quaternion.hpp"
 
 namespace diffpills {
 namespace {
@@ -130,6 +131,30 @@ TEST(Rotation, LeftAndRightMultiplyAndAttitudeJacobian) {
           (left_multiply_matrix(q) * bump - left_multiply_matrix(q) * back) / 2e-6;
       EXPECT_LE((0.5 * G.col(j) - fd).norm(), 1e-9);
     }
+  }
+}
+
+// quaternion_product against Eigen's product, and as a composition of rotations:
+// Q(a (x) b) = Q(a) Q(b) (the scene composes a primitive's attitude on its body's so).
+TEST(Rotation, QuaternionProductIsEigensAndComposesRotations) {
+  Rng rng(7);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector4d a = random_quaternion(rng);
+    const Eigen::Vector4d b = random_quaternion(rng);
+    const Eigen::Quaterniond product =
+        Eigen::Quaterniond(a(0), a(1), a(2), a(3)) * Eigen::Quaterniond(b(0), b(1), b(2), b(3));
+    const Eigen::Vector4d expected(product.w(), product.x(), product.y(), product.z());
+    const Eigen::Vector4d ab = quaternion_product(a, b);
+    EXPECT_LE((ab - expected).norm(), 1e-13 * a.norm() * b.norm());
+    EXPECT_LE((rotation_matrix(ab) - rotation_matrix(a) * rotation_matrix(b)).cwiseAbs().maxCoeff(),
+              1e-14);
+    // R(b)' p = p (x) b*, which the scene's chain rule takes through a composed attitude.
+    const Eigen::Vector4d conjugate(b(0), -b(1), -b(2), -b(3));
+    EXPECT_LE((quaternion_product(a, conjugate) - right_multiply_matrix(b).transpose() * a).norm(),
+              1e-13 * a.norm() * b.norm());
+    // rotation_matrix builds the matrix alone, with the same bits as the attitude the scene and
+    // the pairs keep (their broadphase boxes and world poses must agree exactly).
+    EXPECT_EQ(rotation_matrix(a), detail::UnitQuaternion(a).matrix());
   }
 }
 

@@ -302,7 +302,8 @@ Eigen::MatrixXd ArmShelfProblem::dynamics_hessian(const State&, const Control&,
 }
 
 // Each shape's world pose is fixed in its link's frame f (or in the world, for a board):
-// p = o_f + Q(q_f) r_l, q_p = q_f (x) q_l / |q_l|, the way the scene composes it. With J_s its
+// p = o_f + Q(q_f) r_l, q_p = q_f (x) q_l / |q_l|, as the scene composes it up to rounding (the
+// scene normalizes q_f first). With J_s its
 // Jacobian and C_s its curvature term for the distance's gradient (serial_chain.hpp), the Hessian
 // of the distance in the joint angles is [J_1; J_2]' H [J_1; J_2] + C_1 + C_2, H the 14 x 14
 // Hessian of signed_distance_hessian at the two world poses.
@@ -315,7 +316,7 @@ Eigen::MatrixXd ArmShelfProblem::contact_hessian(const Contact& contact,
     if (contact.bodies[side] >= 1 && contact.bodies[side] < kLinks) {
       const auto f = static_cast<std::size_t>(contact.bodies[side]);
       world[side] = Pose(frames.origin[f] + rotation_matrix(frames.attitude[f]) * shape.pose.r(),
-                         left_multiply_matrix(frames.attitude[f]) * local_attitude);
+                         quaternion_product(frames.attitude[f], local_attitude));
     } else {
       world[side] = Pose(shape.pose.r(), local_attitude);  // the base and the boards stay put
     }

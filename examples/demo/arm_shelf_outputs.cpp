@@ -51,7 +51,7 @@ void draw(Svg& svg, const View& view, const Shape& shape, const Pose& pose,
 // A primitive's world pose on a body at `body`.
 Pose compose(const Pose& body, const Pose& local) {
   return Pose(body.r() + rotation_matrix(body.q()) * local.r(),
-              left_multiply_matrix(body.q()) * local.q());
+              quaternion_product(body.q(), local.q()));
 }
 
 }  // namespace

@@ -4,10 +4,11 @@
 // x_world = r + Q(q) x_body. The functions that rotate (rotation_matrix, rotate_*,
 // quaternion_to_mrp) accept a non-unit q and normalize it internally; their derivatives with
 // respect to q include that normalization, so at a unit q they have no component along q. The
-// product matrices (left_multiply_matrix, right_multiply_matrix, attitude_jacobian) are those of
-// q as given, linear in q; attitude_gradient, built on them, is still the same for every scaling
-// of q, since a dphi/dq that includes the normalization scales as 1 / |q|. Callers are expected
-// to pass a validated quaternion (see Pose); these functions do not check for zero norm.
+// product matrices (left_multiply_matrix, right_multiply_matrix, attitude_jacobian) and
+// quaternion_product are those of q as given, linear in q; attitude_gradient, built on them, is
+// still the same for every scaling of q, since a dphi/dq that includes the normalization scales as
+// 1 / |q|. Callers are expected to pass a validated quaternion (see Pose); these functions do not
+// check for zero norm.
 #pragma once
 
 #include <Eigen/Core>
@@ -36,6 +37,18 @@ Eigen::Matrix<double, 3, 4> rotate_transpose_jacobian(const Eigen::Vector4d& q,
 
 // L(q): the left-multiplication matrix, q (x) p = L(q) p.
 Eigen::Matrix4d left_multiply_matrix(const Eigen::Vector4d& q);
+
+// a (x) b, the Hamilton product of the quaternions as given:
+//   [a0 b0 - av.bv ; a0 bv + b0 av + av x bv],
+// written out (L(a) b without forming L(a), equal to it up to rounding: the terms are summed in
+// another order). It composes every primitive's attitude in a scene query and every frame of a
+// serial chain.
+inline Eigen::Vector4d quaternion_product(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
+  return {a(0) * b(0) - a(1) * b(1) - a(2) * b(2) - a(3) * b(3),
+          a(0) * b(1) + a(1) * b(0) + a(2) * b(3) - a(3) * b(2),
+          a(0) * b(2) - a(1) * b(3) + a(2) * b(0) + a(3) * b(1),
+          a(0) * b(3) + a(1) * b(2) - a(2) * b(1) + a(3) * b(0)};
+}
 
 // R(q): the right-multiplication matrix, p (x) q = R(q) p. (Chains a gradient through a
 // composition of attitudes: d(p (x) q)/dp = R(q).)

@@ -6,12 +6,12 @@
 #include <string>
 #include <utility>
 
-#include "diffpills/rotation.hpp"
-
 namespace diffpills::detail {
 
 std::vector<std::pair<int, int>> broadphase(const Scene& scene, const SceneOutlines& outlines,
-                                            const std::vector<Pose>& body_poses, double margin) {
+                                            const std::vector<Pose>& body_poses, double margin,
+                                            std::vector<UnitQuaternion>& attitudes) {
+  attitudes.clear();
   if (body_poses.size() != scene.bodies().size()) {
     throw std::invalid_argument("body_poses: expected one pose per body, " +
                                 std::to_string(scene.bodies().size()) + ", got " +
@@ -21,17 +21,14 @@ std::vector<std::pair<int, int>> broadphase(const Scene& scene, const SceneOutli
     throw std::invalid_argument("margin: must be finite, of magnitude at most 1e100");
   }
   const double grow = 0.5 * std::max(margin, 0.0);
+  attitudes.reserve(body_poses.size());
+  for (const Pose& pose : body_poses) attitudes.emplace_back(pose.q());
   std::vector<Box> boxes(outlines.primitives.size());
-  int body = -1;  // the body whose pose R, r holds
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d r = Eigen::Vector3d::Zero();
   for (std::size_t p = 0; p < boxes.size(); ++p) {
     const SceneOutlines::Primitive& primitive = outlines.primitives[p];
-    if (primitive.body != body) {
-      body = primitive.body;
-      R = rotation_matrix(body_poses[static_cast<std::size_t>(body)].q());
-      r = body_poses[static_cast<std::size_t>(body)].r();
-    }
+    const int body = primitive.body;
+    const Eigen::Matrix3d& R = attitudes[static_cast<std::size_t>(body)].matrix();
+    const Eigen::Vector3d& r = body_poses[static_cast<std::size_t>(body)].r();
     // The core's origin in the world (checked: the narrowphase takes it as a pose) ...
     const Eigen::Vector3d origin =
         r + R * scene.body(body).shapes()[static_cast<std::size_t>(primitive.shape)].pose.r();

@@ -8,14 +8,18 @@
 #include "box_tree.hpp"
 #include "diffpills/scene.hpp"
 #include "scene_outlines.hpp"
+#include "unit_quaternion.hpp"
 
 namespace diffpills::detail {
 
 // Pairs of indices into outlines.primitives whose boxes overlap, of two checked bodies (filtered
 // during the walk, box_tree.hpp), the earlier body's primitive first, in no particular order.
-// Throws std::invalid_argument as Scene::contacts documents (pose count, margin, a primitive's
-// world position beyond kMaxMagnitude).
+// `attitudes` is emptied, then holds each body's attitude normalized (one per body, in order),
+// for the narrowphase's world poses and chain rule: each body's quaternion is normalized once
+// per query. Throws std::invalid_argument as Scene::contacts documents (pose count, margin, a
+// primitive's world position beyond kMaxMagnitude).
 std::vector<std::pair<int, int>> broadphase(const Scene& scene, const SceneOutlines& outlines,
-                                            const std::vector<Pose>& body_poses, double margin);
+                                            const std::vector<Pose>& body_poses, double margin,
+                                            std::vector<UnitQuaternion>& attitudes);
 
 }  // namespace diffpills::detail

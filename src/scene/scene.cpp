@@ -17,34 +17,42 @@
 #include "diffpills/rotation.hpp"
 #include "diffpills/signed_distance.hpp"
 #include "scene_outlines.hpp"
+#include "unit_quaternion.hpp"
 #include "validation.hpp"
 
 namespace diffpills {
 namespace {
 
-// A primitive's world pose: r + Q(q) r_l, and the unit quaternion (q (x) q_l) / (|q| |q_l|):
-// q (x) q_l itself is as good an attitude, but its entries could exceed 1e100 (or its norm fall
-// below 1e-40) where q's and q_l's do not, and the unit one is always a valid Pose. (The
-// broadphase checked r + Q(q) r_l.)
-Pose world_pose(const Pose& body_pose, const Pose& local) {
-  const Eigen::Vector4d unit = body_pose.q() / body_pose.q().norm();
-  return Pose(body_pose.r() + rotation_matrix(unit) * local.r(),
-              left_multiply_matrix(unit) * (local.q() / local.q().norm()));
+// A primitive's world pose: r + Q(q) r_l, and the unit quaternion q^ (x) q_l / |q_l| (q^ the
+// body's attitude normalized once per query by the broadphase): q (x) q_l itself is as good an
+// attitude, but its entries could exceed 1e100 (or its norm fall below 1e-40) where q's and q_l's
+// do not, and the unit one is always a valid Pose. (The broadphase checked r + Q(q) r_l.)
+Pose world_pose(const Pose& body_pose, const detail::UnitQuaternion& attitude, const Pose& local) {
+  return Pose(body_pose.r() + attitude.matrix() * local.r(),
+              quaternion_product(attitude.unit(), local.q() / local.q().norm()));
 }
 
 // The body's [dr, dq] from its primitive's [dr_p, dq_p] (scene.hpp, "Chain rule"), dq_p taken at
 // the unit quaternion of world_pose: a function of the attitude alone does not change when its
 // quaternion is scaled, so its gradient scales by the inverse, and at q (x) q_l it is
-// dq_p / (|q| |q_l|).
-Eigen::Matrix<double, 7, 1> body_gradient(const Pose& body_pose, const Pose& local,
+// dq_p / (|q| |q_l|). Through the product, d(q (x) q_l)/dq = R(q_l) (rotation.hpp), and
+// R(q_l)' = R(q_l*) (q_l* the conjugate: R's vector part changes sign under the transpose), so
+// R(q_l)' dq_p = dq_p (x) q_l*.
+Eigen::Matrix<double, 7, 1> body_gradient(const detail::UnitQuaternion& attitude, const Pose& local,
                                           const Eigen::Matrix<double, 7, 1>& primitive) {
+  const Eigen::Vector4d& q_l = local.q();
+  const Eigen::Vector4d conjugate(q_l(0), -q_l(1), -q_l(2), -q_l(3));
   Eigen::Matrix<double, 7, 1> out;
   out.head<3>() = primitive.head<3>();
-  out.tail<4>() = rotate_gradient(body_pose.q(), local.r(), primitive.head<3>()) +
-                  right_multiply_matrix(local.q()).transpose() * primitive.tail<4>() /
-                      (body_pose.q().norm() * local.q().norm());
+  out.tail<4>() =
+      attitude.rotate_gradient(local.r(), primitive.head<3>()) +
+      quaternion_product(primitive.tail<4>(), conjugate) * (attitude.inverse_norm() / q_l.norm());
   return out;
 }
+
+// 256 contacts, ~86 KB: below glibc's 128 KiB threshold for mapping an allocation of its own, so
+// the reserve comes from the heap and is not page-faulted in on every query.
+constexpr std::size_t kContactsReserved = 256;
 
 double radius_of(const Shape& shape) {
   return std::visit([](const auto& s) { return s.radius(); }, shape);
@@ -151,24 +159,28 @@ bool Scene::checked(int i, int j) const {
 }
 
 std::vector<Contact> Scene::contacts(const std::vector<Pose>& body_poses, double margin) const {
+  std::vector<detail::UnitQuaternion> attitudes;
   const std::vector<std::pair<int, int>> pairs =
-      detail::broadphase(*this, *outlines_, body_poses, margin);
+      detail::broadphase(*this, *outlines_, body_poses, margin, attitudes);
   // A primitive in several pairs (a robot's link beside every board of a shelf) is posed once per
-  // query: world_pose normalises two quaternions, builds a rotation and checks the result.
+  // query: world_pose normalizes the local quaternion, composes and checks the result.
   std::vector<std::optional<Pose>> world(outlines_->primitives.size());
   const auto world_of = [&](int primitive) -> const Pose& {
     std::optional<Pose>& pose = world[static_cast<std::size_t>(primitive)];
     if (!pose) {
       const detail::SceneOutlines::Primitive& p =
           outlines_->primitives[static_cast<std::size_t>(primitive)];
-      pose = world_pose(body_poses[static_cast<std::size_t>(p.body)],
+      const auto owner = static_cast<std::size_t>(p.body);
+      pose = world_pose(body_poses[owner], attitudes[owner],
                         body(p.body).shapes()[static_cast<std::size_t>(p.shape)].pose);
     }
     return *pose;
   };
-  // Not reserved for every pair: boxes of long thin shapes overlap by the N^2 without a contact
-  // (a hostile review: 3000 parallel sticks, 1.4 GB of address space reserved for none).
+  // Reserved for the pairs, up to kContactsReserved only: boxes of long thin shapes overlap by the
+  // N^2 without a contact (a hostile review: 3000 parallel sticks, 1.4 GB of address space
+  // reserved for none), while a robot's query (tens of pairs) then grows the vector no more.
   std::vector<Contact> found;
+  found.reserve(std::min(pairs.size(), kContactsReserved));
   for (const auto& [u, v] : pairs) {
     const detail::SceneOutlines::Primitive& first =
         outlines_->primitives[static_cast<std::size_t>(u)];
@@ -176,8 +188,6 @@ std::vector<Contact> Scene::contacts(const std::vector<Pose>& body_poses, double
         outlines_->primitives[static_cast<std::size_t>(v)];
     const BodyShape& a = body(first.body).shapes()[static_cast<std::size_t>(first.shape)];
     const BodyShape& b = body(second.body).shapes()[static_cast<std::size_t>(second.shape)];
-    const Pose& pose_a = body_poses[static_cast<std::size_t>(first.body)];
-    const Pose& pose_b = body_poses[static_cast<std::size_t>(second.body)];
     const SignedDistance sd = signed_distance(a.shape, world_of(u), b.shape, world_of(v));
     if (!(sd.distance <= margin)) continue;
 
@@ -187,8 +197,10 @@ std::vector<Contact> Scene::contacts(const std::vector<Pose>& body_poses, double
     contact.distance = sd.distance;
     contact.points = sd.points;
     contact.normal = sd.normal;
-    contact.gradient << body_gradient(pose_a, a.pose, sd.gradient.head<7>()),
-        body_gradient(pose_b, b.pose, sd.gradient.tail<7>());
+    contact.gradient << body_gradient(attitudes[static_cast<std::size_t>(first.body)], a.pose,
+                                      sd.gradient.head<7>()),
+        body_gradient(attitudes[static_cast<std::size_t>(second.body)], b.pose,
+                      sd.gradient.tail<7>());
     const double radii = radius_of(a.shape) + radius_of(b.shape);
     if (sd.penetrating) {
       contact.phi = -radii * radii;  // the cores intersect: flat (proximity.hpp)

@@ -15,15 +15,6 @@ Eigen::Vector4d about_x(double angle) {
 Eigen::Vector4d about_z(double angle) {
   return {std::cos(0.5 * angle), 0.0, 0.0, std::sin(0.5 * angle)};
 }
-// The Hamilton product a (x) b = [a0 b0 - av.bv ; a0 bv + b0 av + av x bv], written out: it runs
-// ~60 times per pose of the arm, and left_multiply_matrix(a) * b built a 4 x 4 matrix in the
-// library first (the same terms, summed in another order: equal to rounding, ~1e-16 relative).
-Eigen::Vector4d product(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
-  return {a(0) * b(0) - a(1) * b(1) - a(2) * b(2) - a(3) * b(3),
-          a(0) * b(1) + a(1) * b(0) + a(2) * b(3) - a(3) * b(2),
-          a(0) * b(2) - a(1) * b(3) + a(2) * b(0) + a(3) * b(1),
-          a(0) * b(3) + a(1) * b(2) - a(2) * b(1) + a(3) * b(0)};
-}
 
 }  // namespace
 
@@ -54,8 +45,9 @@ void forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::
     const Eigen::Matrix3d previous = rotation_matrix(out.attitude[f - 1]);
     if (i <= n) {
       const auto j = static_cast<std::size_t>(i - 1);
-      const Eigen::Vector4d tilted = product(out.attitude[f - 1], about_x(chain.alpha[j]));
-      out.attitude[f] = product(tilted, about_z(q(i - 1)));
+      const Eigen::Vector4d tilted =
+          quaternion_product(out.attitude[f - 1], about_x(chain.alpha[j]));
+      out.attitude[f] = quaternion_product(tilted, about_z(q(i - 1)));
       axis[f] = rotation_matrix(tilted).col(2);  // RotZ(q_i) leaves the z axis where it is
       out.origin[f] = out.origin[f - 1] + chain.a[j] * previous.col(0) + chain.d[j] * axis[f];
     } else {
@@ -88,7 +80,7 @@ void forward_kinematics(const SerialChain& chain, const Eigen::Ref<const Eigen::
       out.d_origin[frame].col(j - 1) =
           z.cross(out.origin[frame] - out.origin[static_cast<std::size_t>(j)]);
       out.d_attitude[frame].col(j - 1) =
-          0.5 * product(Eigen::Vector4d(0.0, z.x(), z.y(), z.z()), out.attitude[frame]);
+          0.5 * quaternion_product(Eigen::Vector4d(0.0, z.x(), z.y(), z.z()), out.attitude[frame]);
     }
   }
 }
@@ -108,12 +100,12 @@ AttachedPoseDerivatives attached_pose_derivatives(const ChainFrames& frames, int
   for (int j = 1; j <= moving; ++j) {
     const Eigen::Vector3d& z_j = frames.axis[static_cast<std::size_t>(j)];
     const Eigen::Vector3d lever = position - frames.origin[static_cast<std::size_t>(j)];
-    const Eigen::Vector4d turned = product(pure(z_j), attitude);
+    const Eigen::Vector4d turned = quaternion_product(pure(z_j), attitude);
     out.jacobian.col(j - 1) << z_j.cross(lever), 0.5 * turned;
     for (int i = 1; i <= j; ++i) {
       const Eigen::Vector3d& z_i = frames.axis[static_cast<std::size_t>(i)];
       const double value = gradient.head<3>().dot(z_i.cross(z_j.cross(lever))) +
-                           0.25 * gradient.tail<4>().dot(product(pure(z_i), turned));
+                           0.25 * gradient.tail<4>().dot(quaternion_product(pure(z_i), turned));
       out.curvature(i - 1, j - 1) = out.curvature(j - 1, i - 1) = value;
     }
   }
