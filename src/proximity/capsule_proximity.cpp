@@ -429,6 +429,16 @@ inline Eigen::Matrix<double, 14, 14> capsule_phi_hessian(const GenericCapsuleSol
   return H;
 }
 
+// generic_proximity as a call of its own, for the Jacobian and the Hessian. Inlined there (as it
+// is into proximity(), where it is all the work), it competed with the points' motion for
+// registers: in one paired measurement the Jacobian took 192-195 ns inlined and 177-181 ns with
+// this call, the Hessian 261-263 and 244-253 ns, with the same bits.
+[[gnu::noinline]] Proximity generic_proximity_outlined(const GenericCapsuleSolution& g,
+                                                       const Capsule& a, const Pose& pose_a,
+                                                       const Capsule& b, const Pose& pose_b) {
+  return generic_proximity(g, a, pose_a, b, pose_b);
+}
+
 }  // namespace
 
 Proximity generic_capsule_proximity(const Capsule& a, const Pose& pose_a, const Capsule& b,
@@ -449,7 +459,7 @@ bool solve_generic_capsules(const Capsule& a, const Pose& pose_a, const Capsule&
 ProximityJacobian generic_capsule_proximity_jacobian(const GenericCapsuleSolution& solution,
                                                      const Capsule& a, const Pose& pose_a,
                                                      const Capsule& b, const Pose& pose_b) {
-  const Proximity first = generic_proximity(solution, a, pose_a, b, pose_b);
+  const Proximity first = generic_proximity_outlined(solution, a, pose_a, b, pose_b);
   const PointsMotion motion = points_motion(solution, axis_jacobians(solution), a, b, first.normal);
   return {first, point_columns(motion.core, solution.scale),
           point_columns(motion.surface, solution.scale)};
@@ -458,7 +468,7 @@ ProximityJacobian generic_capsule_proximity_jacobian(const GenericCapsuleSolutio
 ProximityHessian generic_capsule_proximity_hessian(const GenericCapsuleSolution& solution,
                                                    const Capsule& a, const Pose& pose_a,
                                                    const Capsule& b, const Pose& pose_b) {
-  const Proximity first = generic_proximity(solution, a, pose_a, b, pose_b);
+  const Proximity first = generic_proximity_outlined(solution, a, pose_a, b, pose_b);
   const AxisJacobians jacobians = axis_jacobians(solution);
   const PointsMotion motion = points_motion(solution, jacobians, a, b, first.normal);
   return {{first, point_columns(motion.core, solution.scale),
