@@ -159,7 +159,7 @@ class LineBuilder {
   bool open(json&& container) {
     if (levels_.size() >= kMaxNesting) {
       return fail("arrays and objects nested deeper than " + std::to_string(kMaxNesting) +
-                  " levels (a query needs 4)");
+                  " levels");
     }
     levels_.emplace_back(place(std::move(container)));
     return true;

@@ -3,16 +3,17 @@
 #pragma once
 
 #include <cstddef>
-#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 
 namespace diffpills::app {
 
-// A query nests 4 deep (the query, a shape, its "C", a row of C). Deeper lines are rejected while
-// they are parsed, so nothing recursive (nlohmann copies, compares and dumps values recursively)
-// ever walks a value deep enough to exhaust the stack; 64 leaves room for new fields.
+// A query line nests 4 deep (the query, a shape, its "C", a row of C), a scene line 4 (the line,
+// "poses", a body's pose, its "r") and a scene file 7 (down to a row of a polygon's "C"). Deeper
+// input is rejected while it is parsed, so nothing recursive (nlohmann copies, compares and dumps
+// values recursively) ever walks a value deep enough to exhaust the stack; 64 leaves room for new
+// fields.
 constexpr std::size_t kMaxNesting = 64;
 
 // Parses a line holding one JSON value. Objects are std::map based (nlohmann::json, not
@@ -36,31 +37,28 @@ std::string key_text(const std::string& key);
 // destructor first moves a non-empty container's children into a new vector (to free deep values
 // without recursion), and that allocation fails where memory ran out, inside a destructor: a
 // std::bad_alloc there ends the program (a hostile review: a line of 4 million numbers under
-// ulimit -v, every later line lost). Here each container is emptied from its last child, each
-// child released first, so every destructor run meets empty containers; the commands' values nest
-// at most kMaxNesting deep, so the recursion is bounded.
+// ulimit -v, every later line lost). Here each child of a container is released in place, then
+// the container is cleared, so every destructor run meets an empty container (whose flattening
+// reserves nothing) or a scalar; the commands' values nest at most kMaxNesting deep, so the
+// recursion is bounded. Nothing here can throw: get_ptr gives a null pointer for another type
+// (get_ref would throw), and clear() is noexcept (an ordered_map's erase is not).
 template <class Json>
 void release(Json& value) noexcept {
-  if (value.is_array()) {
-    auto& items = value.template get_ref<typename Json::array_t&>();
-    while (!items.empty()) {
-      release(items.back());
-      items.pop_back();
-    }
-  } else if (value.is_object()) {
-    auto& members = value.template get_ref<typename Json::object_t&>();
-    while (!members.empty()) {
-      const auto last = std::prev(members.end());
-      release(last->second);
-      members.erase(last);
-    }
+  if (auto* items = value.template get_ptr<typename Json::array_t*>()) {
+    for (Json& item : *items) release(item);
+    items->clear();
+  } else if (auto* members = value.template get_ptr<typename Json::object_t*>()) {
+    for (auto& member : *members) release(member.second);
+    members->clear();
   }
 }
 
 // A value released (above) when it goes out of scope, by any path.
 template <class Json>
 struct Released {
-  Released() = default;
+  // nlohmann's default constructor is noexcept and makes a null (no allocation) by delegating to
+  // basic_json(value_t), which can throw for other types; the check follows that call.
+  Released() = default;  // NOLINT(bugprone-exception-escape)
   explicit Released(Json&& json) : value(std::move(json)) {}
   Released(const Released&) = delete;
   Released& operator=(const Released&) = delete;

@@ -49,7 +49,9 @@ nlohmann::ordered_json answer(const Scene& scene, double default_margin, const j
     const std::string name = key_text(item.key());
     const std::string field = "poses." + name;
     if (index < 0) {
-      throw std::invalid_argument(field + ": no body is named '" + name + "'");
+      std::string message = field;
+      message.append(": no body is named '").append(name).append("'");
+      throw std::invalid_argument(message);
     }
     poses[static_cast<std::size_t>(index)] = parse_pose(item.value(), field);
     posed[static_cast<std::size_t>(index)] = true;

@@ -58,7 +58,7 @@ CommandRun run(const std::vector<std::string>& arguments, const std::string& inp
 }
 
 std::string write_file(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + name;
+  std::string path = ::testing::TempDir() + name;
   std::ofstream(path) << text;
   return path;
 }
@@ -257,6 +257,17 @@ TEST(SceneCli, BadSceneFilesAndArgumentsEndWithStatus2) {
   EXPECT_TRUE(mentions(file_failure(R"({"bodies": [{"name": "a", "shapes": []}],
                                        "exclude": [["a"]]})"),
                        "exclude[0]: must be a pair of body names"));
+  // Nested past the limit: named where the parser stopped, with the limit only (it once added
+  // "(a query needs 4)", which a scene file is not: it needs 7). The message is read after the
+  // file's path, which may hold any word.
+  const std::string deep_path = write_file(
+      "deep_scene.json", "{\"bodies\": " + std::string(70, '[') + std::string(70, ']') + "}");
+  const std::string deep = failure({deep_path});
+  ASSERT_TRUE(mentions(deep, deep_path)) << deep;
+  const std::string deep_message = deep.substr(deep.find(deep_path) + deep_path.size());
+  EXPECT_TRUE(mentions(deep_message, "bodies[0][0][0]")) << deep;
+  EXPECT_TRUE(mentions(deep_message, "nested deeper than 64 levels")) << deep;
+  EXPECT_FALSE(mentions(deep_message, "query")) << deep;
 }
 
 TEST(SceneCli, EmptySceneAndRoundTrip) {
