@@ -40,7 +40,7 @@ std::string read(const std::filesystem::path& path) {
 // Runs the demo with --quick and the extra arguments into a fresh folder named name, its
 // standard output into stdout.txt there.
 std::filesystem::path run_demo(const std::string& name, const std::string& arguments) {
-  const std::filesystem::path folder = std::filesystem::temp_directory_path() / name;
+  std::filesystem::path folder = std::filesystem::temp_directory_path() / name;
   std::filesystem::remove_all(folder);
   std::filesystem::create_directories(folder);
   const std::string command = demo_program + " " + folder.string() + " --quick " + arguments +
@@ -68,7 +68,7 @@ std::vector<Eigen::VectorXd> csv_rows(const std::filesystem::path& path) {
     while (std::getline(cells, cell, ',')) {
       if (!cell.empty()) values.push_back(std::stod(cell));
     }
-    rows.push_back(
+    rows.emplace_back(
         Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())));
   }
   return rows;
@@ -360,7 +360,7 @@ TEST(DemoOutputs, IpoptBlockWithoutAPointHasNullCostAndViolation) {
   EXPECT_EQ(without_point["status"], "stopped (-12)");
   EXPECT_TRUE(without_point["cost"].is_null());
   EXPECT_TRUE(without_point["max_violation"].is_null());
-  run.states.push_back(Eigen::VectorXd::Zero(2));
+  run.states.emplace_back(Eigen::VectorXd::Zero(2));
   const nlohmann::ordered_json with_point = diffpills::examples::ipopt_summary(run);
   EXPECT_EQ(with_point["cost"], 3.5);
   EXPECT_EQ(with_point["max_violation"], 0.25);
@@ -413,6 +413,12 @@ TEST(DemoOutputs, CommandLine) {
                             "5s", "' 5'", "'5 '", "--quick"}) {
     EXPECT_EQ(status(std::string("--quick --ipopt-cpu-seconds ") + limit), 2) << limit;
   }
+  // A limit is read before --help ends the program: the smallest normal double is accepted, also
+  // written just below it (strtod rounds it up, and glibc sets ERANGE for it all the same).
+  for (const char* limit : {"2.2250738585072014e-308", "2.2250738585072012e-308", "1.7e308"}) {
+    EXPECT_EQ(status(std::string("--ipopt-cpu-seconds ") + limit + " --help"), 0) << limit;
+  }
+  EXPECT_EQ(status("--ipopt-cpu-seconds 2.2250738585072011e-308 --help"), 2);  // a subnormal
 }
 
 }  // namespace

@@ -12,7 +12,6 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cctype>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -270,14 +269,15 @@ void print_unsolved(const std::string& name, const std::optional<examples::Ipopt
 // text as a number of seconds, all of it read ("120", "1e-9"), in double's normal range
 // [2.2e-308, 1.8e308] and > 0, or nothing. Not text with leading white space (strtod skips it;
 // trailing space is not read either), nor a number strtod cannot hold: it turns 1e-400 into 0,
-// 1e400 into infinity (both ERANGE), and 1e-310 into a subnormal that has lost digits.
+// 1e400 into infinity, and 1e-310 into a subnormal that has lost digits, all refused by their
+// values. (Not by errno: glibc also sets ERANGE for text just below 2^-1022 that rounds up to
+// it, a normal number.)
 std::optional<double> seconds_limit(const char* text) {
   if (std::isspace(static_cast<unsigned char>(text[0])) != 0) return std::nullopt;
   char* end = nullptr;
-  errno = 0;
   const double value = std::strtod(text, &end);
   const bool normal = std::isfinite(value) && value >= std::numeric_limits<double>::min();
-  if (end == text || *end != '\0' || errno == ERANGE || !normal) return std::nullopt;
+  if (end == text || *end != '\0' || !normal) return std::nullopt;
   return value;
 }
 
