@@ -159,14 +159,16 @@ std::optional<detail::CapsulePair> capsule_pair(const Shape& a, const Shape& b,
 // The batch of either query: the vector kernel answers what it can of each block if `capsules`
 // holds its pair, and `query(pose_a[i], pose_b[i], i)` writes row i of value and gradient for
 // every other row. `name` and `value_name` are the function's and its output's names, for
-// messages.
+// messages. value and gradient are views taken by const reference; the rows are written through
+// copies of them, which view the same numbers.
 template <class Query>
 void run_batch(const char* name, const char* value_name, const Eigen::Ref<const PositionArray>& r_a,
                const Eigen::Ref<const QuaternionArray>& q_a,
                const Eigen::Ref<const PositionArray>& r_b,
-               const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Ref<Eigen::VectorXd> value,
-               Eigen::Ref<GradientArray> gradient, const BatchOptions& options,
-               const std::optional<detail::CapsulePair>& capsules, const Query& query) {
+               const Eigen::Ref<const QuaternionArray>& q_b,
+               const Eigen::Ref<Eigen::VectorXd>& value, const Eigen::Ref<GradientArray>& gradient,
+               const BatchOptions& options, const std::optional<detail::CapsulePair>& capsules,
+               const Query& query) {
   const Eigen::Index n = r_a.rows();
   if (q_a.rows() != n || r_b.rows() != n || q_b.rows() != n) {
     throw std::invalid_argument(

@@ -227,8 +227,8 @@ void capsule_rows(const CapsulePair& pair, const Eigen::Ref<const PositionArray>
                   const Eigen::Ref<const QuaternionArray>& q_a,
                   const Eigen::Ref<const PositionArray>& r_b,
                   const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Index begin,
-                  Eigen::Index end, Eigen::Ref<Eigen::VectorXd> value,
-                  Eigen::Ref<GradientArray> gradient, std::uint8_t* left) {
+                  Eigen::Index end, const Eigen::Ref<Eigen::VectorXd>& value,
+                  const Eigen::Ref<GradientArray>& gradient, std::uint8_t* left) {
   HWY_DYNAMIC_DISPATCH(CapsuleRows)(pair, r_a, q_a, r_b, q_b, begin, end, value, gradient, left);
 }
 

@@ -45,14 +45,15 @@ bool capsule_rows_apply(const CapsulePair& pair);
 
 // Rows [begin, end) of the batch: writes value(i) (phi or the signed distance) and gradient.row(i)
 // of every row it answers and sets left[i - begin] = 1 for each row it leaves to the scalar path
-// (0 for the others). end - begin <= kCapsuleRowsBlock.
+// (0 for the others). end - begin <= kCapsuleRowsBlock. The outputs are views taken by const
+// reference; the kernel writes through a copy of each Ref, which views the same numbers.
 constexpr Eigen::Index kCapsuleRowsBlock = 512;
 void capsule_rows(const CapsulePair& pair, const Eigen::Ref<const PositionArray>& r_a,
                   const Eigen::Ref<const QuaternionArray>& q_a,
                   const Eigen::Ref<const PositionArray>& r_b,
                   const Eigen::Ref<const QuaternionArray>& q_b, Eigen::Index begin,
-                  Eigen::Index end, Eigen::Ref<Eigen::VectorXd> value,
-                  Eigen::Ref<GradientArray> gradient, std::uint8_t* left);
+                  Eigen::Index end, const Eigen::Ref<Eigen::VectorXd>& value,
+                  const Eigen::Ref<GradientArray>& gradient, std::uint8_t* left);
 
 // The instruction set capsule_rows runs on in this process (Highway's name: "AVX3" for AVX-512,
 // "AVX2", "SSE4", "SSSE3", "SCALAR" for plain code), for benchmarks and tests.

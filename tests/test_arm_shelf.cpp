@@ -187,7 +187,7 @@ TEST(ArmShelf, ConstraintsWrittenIntoUsedStorageEqualFreshOnes) {
   const ArmShelfScenario& s = problem.scenario();
   const std::vector<Eigen::VectorXd> guess = problem.retreat_controls();
   std::vector<ArmShelfProblem::State> states{s.start};
-  for (const Eigen::VectorXd& u : guess) states.push_back(states.back() + s.dt * u);
+  for (const Eigen::VectorXd& u : guess) states.emplace_back(states.back() + s.dt * u);
   const auto control = [&](int k) {
     return k + 1 < s.knots ? ArmShelfProblem::Control(guess[static_cast<std::size_t>(k)])
                            : ArmShelfProblem::Control::Zero();

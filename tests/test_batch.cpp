@@ -307,6 +307,7 @@ TEST(Batch, CallersOnSeveralThreadsAtOnceGetTheSingleCalls) {
   const Arrays arrays = random_arrays(rng, 3'000);
   std::vector<int> all_equal(4, 0);
   std::vector<std::thread> callers;
+  callers.reserve(4);
   for (int t = 0; t < 4; ++t) {
     callers.emplace_back([&, t] {
       Eigen::VectorXd phi(3'000);

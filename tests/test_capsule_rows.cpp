@@ -274,7 +274,8 @@ TEST(CapsuleRows, CloseCoresAgreeWithTheSingleCall) {
     Rows rows{PositionArray(0, 3), PositionArray(0, 3), QuaternionArray(0, 4),
               QuaternionArray(0, 4)};
     std::vector<Pose> poses_a, poses_b;
-    for (double gap = 1e-9; gap < 0.5; gap *= 3.1) {
+    double gap = 1e-9;
+    for (int step = 0; step < 18; ++step, gap *= 3.1) {  // gaps 1e-9 3.1^step, up to 0.23
       for (int trial = 0; trial < 20; ++trial) {
         // b crosses a's axis at 70 degrees, `gap` above it, with its crossing point at s_b along
         // b (an end when |s_b| = 0.5) over a's point at s_a; then the whole scene is turned.

@@ -36,7 +36,7 @@ TestShape many_sided(Rng& rng, int count, bool half) {
   const double span = half ? M_PI : 2.0 * M_PI;
   for (int i = 0; i < count; ++i) {
     const double angle = span * (i + 0.3 * uniform(rng)) / (half ? count - 1 : count);
-    points.push_back(rotation * Eigen::Vector2d(a * std::cos(angle), b * std::sin(angle)));
+    points.emplace_back(rotation * Eigen::Vector2d(a * std::cos(angle), b * std::sin(angle)));
   }
   if (half) points.back() = rotation * Eigen::Vector2d(-a, 0.0);
   const Eigen::Vector2d centre = 0.3 * (points[0] + points[count / 3] + points[2 * count / 3]);
@@ -328,7 +328,8 @@ PaddedPolygon half_ellipse(int count, double turn) {
   std::vector<Eigen::Vector2d> points;
   for (int i = 0; i < count; ++i) {
     const double angle = M_PI + M_PI * i / (count - 1);
-    points.push_back(rotation * (Eigen::Vector2d(std::cos(angle), 0.5 * std::sin(angle)) - origin));
+    points.emplace_back(rotation *
+                        (Eigen::Vector2d(std::cos(angle), 0.5 * std::sin(angle)) - origin));
   }
   Eigen::MatrixX2d C(count, 2);
   Eigen::VectorXd d(count);
@@ -361,8 +362,9 @@ TEST(LargePolygons, LargeWindowsReturnTheMiddleOfParallelEdges) {
     // Even trials: the straight edges along the body frames' axes, where the chains' boxes in
     // the frame of A's normal are tight. Odd ones: turned by 48ths of a turn.
     const bool quarter = trial % 2 == 0;
-    const double turn_a = quarter ? M_PI / 2 * (trial % 8 / 2) : 2 * M_PI * trial / 48;
-    const double turn_b = quarter ? M_PI / 2 * (trial % 16 / 4) : 2 * M_PI * (trial * 7 % 48) / 48;
+    const int quarters_a = trial % 8 / 2, quarters_b = trial % 16 / 4;  // whole quarter turns
+    const double turn_a = quarter ? M_PI / 2 * quarters_a : 2 * M_PI * trial / 48;
+    const double turn_b = quarter ? M_PI / 2 * quarters_b : 2 * M_PI * (trial * 7 % 48) / 48;
     const PaddedPolygon a = half_ellipse(400, turn_a), b = half_ellipse(400, turn_b);
     // No shift puts the straight edges right across the line between the polygons' boxes, where
     // the chains' bounds are exact and every chain pair holding a point of the overlap ties.

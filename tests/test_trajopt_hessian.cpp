@@ -157,7 +157,11 @@ int check_problem(const Problem& problem, const std::vector<std::pair<int, Vecto
   const int n = problem.state_size(), m = problem.control_size();
   int nonzero = 0, kinks = 0;
   double worst_dynamics = 0.0, worst_constraints = 0.0;
-  for (const auto& [k, z] : points) {
+  for (const auto& point : points) {
+    // Named, not a structured binding: the lambdas below capture k, which C++17 allows only for
+    // a variable (clang refuses the binding; GCC accepts it as an extension).
+    const int k = point.first;
+    const VectorXd& z = point.second;
     const bool last = k == problem.knots() - 1;
     const VectorXd x = z.head(n), u = last ? VectorXd() : VectorXd(z.tail(m));
     const VectorXd at = last ? x : z;

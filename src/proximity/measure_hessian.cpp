@@ -13,7 +13,7 @@ Eigen::Matrix<double, 14, 14> measure_hessian(const Pose& pose_a, const Pose& po
                                               const Eigen::Matrix<double, 3, 14>& dw) {
   const std::array<const Pose*, 2> poses = {&pose_a, &pose_b};
   Eigen::Matrix<double, 14, 14> H;
-  for (int side = 0; side < 2; ++side) {
+  for (Eigen::Index side = 0; side < 2; ++side) {
     const auto index = static_cast<std::size_t>(side);
     const double sign = side == 0 ? 1.0 : -1.0;
     const UnitQuaternion attitude(poses[index]->q());
@@ -25,7 +25,7 @@ Eigen::Matrix<double, 14, 14> measure_hessian(const Pose& pose_a, const Pose& po
     moved.middleCols<3>(7 * side) -= Eigen::Matrix3d::Identity();
     moved.middleCols<4>(7 * side + 3) -= rotate;
     const Eigen::Matrix<double, 3, 14> xi_jacobian = rotation.transpose() * moved;
-    const int r = 7 * side, q = 7 * side + 3;
+    const Eigen::Index r = 7 * side, q = 7 * side + 3;
     H.middleRows<3>(r) = sign * dw;
     H.middleRows<4>(q) = sign * (rotate.transpose() * dw +
                                  attitude.rotate_transpose_jacobian(w).transpose() * xi_jacobian);

@@ -97,7 +97,7 @@ PointMotion add_point_jacobians(const PairFrame& frame, const PosedCore& a,
   const Eigen::Vector3d p1 = a.r + a.attitude.matrix() * side_a.body_point;
   const Eigen::Vector3d p2 = b.r + b.attitude.matrix() * side_b.body_point;
 
-  const PointMotion motion = core_point_motion(a, side_a, b, side_b);
+  PointMotion motion = core_point_motion(a, side_a, b, side_b);
 
   Matrix3x14 dnormal = Matrix3x14::Zero();
   switch (normal_rule(frame, a, b, p1, p2)) {

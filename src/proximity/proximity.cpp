@@ -60,7 +60,7 @@ Sides reference_sides(const ShapeA& a, const PosedCore& pa, const ShapeB& b, con
   const detail::ParametricCore core_a = parametric_core(a, pa, frame);
   const detail::ParametricCore core_b = parametric_core(b, pb, frame);
   const detail::PairProblem problem = detail::make_pair_problem(core_a, pa, core_b, pb);
-  const Sides sides = detail::core_solutions(problem, detail::solve_pair(problem));
+  Sides sides = detail::core_solutions(problem, detail::solve_pair(problem));
   check_inside(a, sides[0], frame);
   check_inside(b, sides[1], frame);
   return sides;
@@ -90,6 +90,25 @@ Result query(const ShapeA& a, const Pose& pose_a, const ShapeB& b, const Pose& p
   } else {
     return detail::make_proximity(frame, pose_a, posed_a, sides[0], pose_b, posed_b, sides[1]);
   }
+}
+
+// Two capsules in the generic case (capsule_proximity.hpp) go to their fused second-order pass,
+// under the default method; everything else to the general pipeline.
+template <class Result, auto fused>
+Result fused_or_general(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                        const ProximityOptions& options) {
+  const Capsule* capsule_a = std::get_if<Capsule>(&a);
+  const Capsule* capsule_b = std::get_if<Capsule>(&b);
+  detail::GenericCapsuleSolution solution;
+  if (options.method == Method::kDefault && capsule_a != nullptr && capsule_b != nullptr &&
+      detail::solve_generic_capsules(*capsule_a, pose_a, *capsule_b, pose_b, solution)) {
+    return fused(solution, *capsule_a, pose_a, *capsule_b, pose_b);
+  }
+  return std::visit(
+      [&](const auto& shape_a, const auto& shape_b) {
+        return query<Result>(shape_a, pose_a, shape_b, pose_b, options);
+      },
+      a, b);
 }
 
 }  // namespace
@@ -161,36 +180,14 @@ ProximityJacobian proximity_jacobian(const Shape& a, const Pose& pose_a, const S
 
 ProximityHessian proximity_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
                                    const Pose& pose_b, const ProximityOptions& options) {
-  const Capsule* capsule_a = std::get_if<Capsule>(&a);
-  const Capsule* capsule_b = std::get_if<Capsule>(&b);
-  detail::GenericCapsuleSolution solution;
-  if (options.method == Method::kDefault && capsule_a != nullptr && capsule_b != nullptr &&
-      detail::solve_generic_capsules(*capsule_a, pose_a, *capsule_b, pose_b, solution)) {
-    return detail::generic_capsule_proximity_hessian(solution, *capsule_a, pose_a, *capsule_b,
-                                                     pose_b);
-  }
-  return std::visit(
-      [&](const auto& shape_a, const auto& shape_b) {
-        return query<ProximityHessian>(shape_a, pose_a, shape_b, pose_b, options);
-      },
-      a, b);
+  return fused_or_general<ProximityHessian, detail::generic_capsule_proximity_hessian>(
+      a, pose_a, b, pose_b, options);
 }
 
 ProximityWithHessian proximity_with_hessian(const Shape& a, const Pose& pose_a, const Shape& b,
                                             const Pose& pose_b, const ProximityOptions& options) {
-  const Capsule* capsule_a = std::get_if<Capsule>(&a);
-  const Capsule* capsule_b = std::get_if<Capsule>(&b);
-  detail::GenericCapsuleSolution solution;
-  if (options.method == Method::kDefault && capsule_a != nullptr && capsule_b != nullptr &&
-      detail::solve_generic_capsules(*capsule_a, pose_a, *capsule_b, pose_b, solution)) {
-    return detail::generic_capsule_proximity_with_hessian(solution, *capsule_a, pose_a, *capsule_b,
-                                                          pose_b);
-  }
-  return std::visit(
-      [&](const auto& shape_a, const auto& shape_b) {
-        return query<ProximityWithHessian>(shape_a, pose_a, shape_b, pose_b, options);
-      },
-      a, b);
+  return fused_or_general<ProximityWithHessian, detail::generic_capsule_proximity_with_hessian>(
+      a, pose_a, b, pose_b, options);
 }
 
 namespace detail {

@@ -46,9 +46,10 @@ TestShape random_polygon(Rng& rng, double scale) {
   Eigen::Matrix2d map =
       Eigen::Rotation2Dd(turn).toRotationMatrix() * Eigen::Vector2d(1.0, stretch).asDiagonal();
   std::vector<Eigen::Vector2d> vertices;
+  vertices.reserve(angles.size());
   for (double angle : angles) {
-    vertices.push_back(map *
-                       (radius_of_circle * Eigen::Vector2d(std::cos(angle), std::sin(angle))));
+    vertices.emplace_back(map *
+                          (radius_of_circle * Eigen::Vector2d(std::cos(angle), std::sin(angle))));
   }
   // Move a random interior point (a convex combination with weights bounded away from zero) to
   // the origin.
@@ -68,12 +69,12 @@ TestShape random_polygon(Rng& rng, double scale) {
     const Eigen::Vector2d edge = vertices[(i + 1) % count] - vertices[i];
     const Eigen::Vector2d outward(edge.y(), -edge.x());
     const double row_scale = uniform(rng, 0.5, 2.0);  // rows need not be unit
-    normals.push_back(row_scale * outward.normalized());
+    normals.emplace_back(row_scale * outward.normalized());
     offsets.push_back(normals.back().dot(vertices[i]));
   }
   const double extra = uniform(rng, 0.0, 1.0);
   if (extra < 0.25) {  // an exact duplicate, scaled
-    normals.push_back(3.0 * normals[0]);
+    normals.emplace_back(3.0 * normals[0]);
     offsets.push_back(3.0 * offsets[0]);
   } else if (extra < 0.5) {  // a loose row, implied by the others
     normals.push_back(normals[1]);
@@ -115,7 +116,7 @@ WorldCore to_world(const TestShape& shape, const Pose& pose) {
   const Eigen::Matrix<long double, 3, 3> R = rotation.normalized().toRotationMatrix();
   WorldCore core;
   for (const auto& v : shape.body_vertices) {
-    core.vertices.push_back(pose.r().cast<long double>() + R * v.cast<long double>());
+    core.vertices.emplace_back(pose.r().cast<long double>() + R * v.cast<long double>());
   }
   return core;
 }

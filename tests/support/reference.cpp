@@ -131,7 +131,7 @@ SignedCoreDistance brute_force_signed_distance(const WorldCore& a, const WorldCo
   }
   std::vector<Vec3L> w;
   for (const auto& va : a.vertices) {
-    for (const auto& vb : b.vertices) w.push_back(va - vb);
+    for (const auto& vb : b.vertices) w.emplace_back(va - vb);
   }
   const long double slack = 1e-12L * scale;
   SignedCoreDistance best{std::numeric_limits<long double>::infinity(), Vec3L::Zero()};
@@ -171,10 +171,10 @@ long double support(const WorldCore& core, const Vec3L& n) {
 std::vector<Vec3L> edge_directions(const WorldCore& core) {
   std::vector<Vec3L> edges;
   const std::size_t n = core.vertices.size();
-  if (n == 2) edges.push_back(core.vertices[1] - core.vertices[0]);
+  if (n == 2) edges.emplace_back(core.vertices[1] - core.vertices[0]);
   if (n >= 3) {
     for (std::size_t i = 0; i < n; ++i)
-      edges.push_back(core.vertices[(i + 1) % n] - core.vertices[i]);
+      edges.emplace_back(core.vertices[(i + 1) % n] - core.vertices[i]);
   }
   return edges;
 }
@@ -196,7 +196,7 @@ long double brute_force_penetration_depth(const WorldCore& a, const WorldCore& b
     for (const Vec3L& f : edge_directions(b)) {
       const Vec3L c = e.cross(f);
 
-      if (c.norm() > 1e-15L * e.norm() * f.norm()) axes.push_back(c / c.norm());
+      if (c.norm() > 1e-15L * e.norm() * f.norm()) axes.emplace_back(c / c.norm());
     }
   }
   long double depth = std::numeric_limits<long double>::infinity();
