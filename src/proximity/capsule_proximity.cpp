@@ -431,8 +431,9 @@ inline Eigen::Matrix<double, 14, 14> capsule_phi_hessian(const GenericCapsuleSol
 
 // generic_proximity as a call of its own, for the Jacobian and the Hessian. Inlined there (as it
 // is into proximity(), where it is all the work), it competed with the points' motion for
-// registers: in one paired measurement the Jacobian took 192-195 ns inlined and 177-181 ns with
-// this call, the Hessian 261-263 and 244-253 ns, with the same bits.
+// registers: in a paired measurement on a Zen 5 the Jacobian took 192-195 ns inlined and 177-181
+// ns with this call, the Hessian 261-263 and 244-253 ns, with the same bits (2-6% and 1-3% on an
+// Intel Xeon, BENCHMARKS.md 2026-11-29).
 [[gnu::noinline]] Proximity generic_proximity_outlined(const GenericCapsuleSolution& g,
                                                        const Capsule& a, const Pose& pose_a,
                                                        const Capsule& b, const Pose& pose_b) {
