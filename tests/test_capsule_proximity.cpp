@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "diffpills/diffpills.hpp"
@@ -351,6 +352,47 @@ TEST(CapsuleProximity, ScalingByAPowerOfTwoIsExact) {
       }
     }
   }
+}
+
+// Q(2^m q) = Q(q): a quaternion scaled by a power of two, from near the smallest norm a Pose takes
+// (1e-40) to near the largest (2e100), leaves phi, the points and the normal bit for bit and
+// divides that quaternion's gradient by 2^m exactly (the fused pass forms each axis from the raw
+// quaternion and 1 / |q|^2, capsule_proximity.cpp); and the answer still matches the brute force
+// and the general pipeline, which normalizes q first.
+TEST(CapsuleProximity, QuaternionScaledByAPowerOfTwo) {
+  Rng rng(1308);
+  const std::pair<int, int> exponents[] = {{-128, 330}, {330, -128}, {-60, -60}, {60, 60}};
+  int checked = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Pair p = random_pair(rng, 1.0);
+    // 2^-128 |q| >= 1e-40 and 2^330 |q| <= 2e100.
+    const auto in_range = [](const Pose& pose) {
+      return pose.q().norm() >= 0.04 && pose.q().norm() <= 9.0;
+    };
+    if (!generic(p) || !in_range(p.pose_a) || !in_range(p.pose_b)) continue;
+    ++checked;
+    const Proximity base = fused(p);
+    for (const auto& [m_a, m_b] : exponents) {
+      SCOPED_TRACE(::testing::Message() << "pair " << i << ", m = " << m_a << ", " << m_b);
+      const Pair turned{p.a, p.b, Pose(p.pose_a.r(), std::ldexp(1.0, m_a) * p.pose_a.q()),
+                        Pose(p.pose_b.r(), std::ldexp(1.0, m_b) * p.pose_b.q())};
+      ASSERT_TRUE(generic(turned));
+      const Proximity result = fused(turned);
+      ASSERT_EQ(result.phi, base.phi);
+      ASSERT_EQ(result.normal, base.normal);
+      for (int c = 0; c < 2; ++c) {
+        ASSERT_EQ(result.core_points[c], base.core_points[c]);
+        ASSERT_EQ(result.points[c], base.points[c]);
+      }
+      ASSERT_EQ(result.gradient.segment<3>(0), base.gradient.segment<3>(0));
+      ASSERT_EQ(result.gradient.segment<3>(7), base.gradient.segment<3>(7));
+      ASSERT_EQ(result.gradient.segment<4>(3), std::ldexp(1.0, -m_a) * base.gradient.segment<4>(3));
+      ASSERT_EQ(result.gradient.segment<4>(10),
+                std::ldexp(1.0, -m_b) * base.gradient.segment<4>(10));
+      expect_matches_references(turned, 1e-13);
+    }
+  }
+  EXPECT_GT(checked, 250);
 }
 
 // The same for the Jacobians (position columns unitless, quaternion columns a length) and phi's

@@ -356,7 +356,10 @@ TEST(SignedDistance, PowerOfTwoScalingIsExact) {
 }
 
 // Apart, the signed distance is |p1 - p2| - R1 - R2 of proximity()'s closest points, and its
-// gradient is proximity's d phi / (2 |p1 - p2|).
+// gradient is proximity's d phi / (2 |p1 - p2|). The closest points are the same bits, except for
+// two capsules: proximity() takes their fused pass (capsule_proximity.hpp, which forms each axis
+// from the raw quaternion), and it agrees with the general pipeline the signed distance runs to
+// rounding (proximity.hpp's kDefault), here within 1e-14 of the coordinates' size (at most ~6).
 TEST(SignedDistance, ApartItIsTheProximitysDistance) {
   Rng rng(10);
   for (const Pair pair : kPairs) {
@@ -368,8 +371,13 @@ TEST(SignedDistance, ApartItIsTheProximitysDistance) {
       const double gap = (p.core_points[1] - p.core_points[0]).norm();
       EXPECT_FALSE(sd.penetrating);
       EXPECT_NEAR(sd.distance, gap - radius(c.a.shape) - radius(c.b.shape), 1e-14);
-      EXPECT_EQ(sd.core_points[0], p.core_points[0]);
-      EXPECT_EQ(sd.core_points[1], p.core_points[1]);
+      for (int k = 0; k < 2; ++k) {
+        if (pair == Pair::kCapsuleCapsule) {
+          EXPECT_LE((sd.core_points[k] - p.core_points[k]).cwiseAbs().maxCoeff(), 6e-14);
+        } else {
+          EXPECT_EQ(sd.core_points[k], p.core_points[k]);
+        }
+      }
       EXPECT_LE((sd.gradient - p.gradient / (2.0 * gap)).norm(), 1e-9 * (1 + sd.gradient.norm()));
     }
   }

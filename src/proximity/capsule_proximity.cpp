@@ -30,30 +30,39 @@ bool frame_exponent(double size, int& exponent) {
   return exponent >= -1000;
 }
 
-// AxisAttitude (capsule_proximity.hpp) of a quaternion, the body x axis being
-//   u = Q(q^) e_x = [1 - 2 (y^2 + z^2), 2 (x y + w z), 2 (x z - w y)]
-// (the first column of unit_quaternion.cpp's Q). Tried: u = A(q) / |q|^2 from the raw q (A the
-// same quadratic form), one division and no square root; measured 4 ns slower per query.
-AxisAttitude axis_attitude(const Eigen::Vector4d& q) {
+// AxisAttitude (capsule_proximity.hpp) of a quaternion q = (w, x, y, z), the body x axis being
+//   u = Q(q^) e_x = A(q) / |q|^2,  A(q) = [w^2 + x^2 - y^2 - z^2, 2 (x y + w z), 2 (x z - w y)]
+// (the first column of unit_quaternion.cpp's Q, each entry quadratic in q). From the raw q the
+// axis takes one division on the way to s, where normalizing q first put a square root and a
+// division there. q^ and 1 / |q| (the Jacobians' and the Hessian's) come from the same 1 / |q|^2
+// off that path, and proximity() drops them. Forced inline: as a call, returning the struct
+// through memory, the query took ~3 ns longer (BENCHMARKS.md, 2026-11-29).
+[[gnu::always_inline]] inline AxisAttitude axis_attitude(const Eigen::Vector4d& q) {
   // Pose keeps |q| within [1e-40, 2e100], so |q|^2 neither underflows nor overflows.
-  const double inverse_norm = 1.0 / std::sqrt(q.squaredNorm());
-  const Eigen::Vector4d unit = q * inverse_norm;
-  const double w = unit(0), x = unit(1), y = unit(2), z = unit(3);
-  return {
-      unit, inverse_norm,
-      Eigen::Vector3d(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y))};
+  const double w = q(0), x = q(1), y = q(2), z = q(3);
+  const double inverse_norm2 = 1.0 / q.squaredNorm();
+  const double inverse_norm = std::sqrt(inverse_norm2);
+  const Eigen::Vector3d quadratic(w * w + x * x - y * y - z * z, 2.0 * (x * y + w * z),
+                                  2.0 * (x * z - w * y));
+  return {q * inverse_norm, inverse_norm, inverse_norm2, quadratic * inverse_norm2};
 }
 
-// d(e . Q(q^) e_x) / dq for the q as given: J' e with J = d(Q(q^) e_x) / dq^, whose columns
-// (w, x, y, z) are 2 [w z -y]', 2 [x y z]', 2 [-y x -w]', 2 [-z w x]' (valid on the unit sphere,
-// where 1 - 2 (y^2 + z^2) = w^2 + x^2 - y^2 - z^2), then the normalization's derivative
-// (I - q^ q^') / |q|. The batch kernel (capsule_rows.cpp) uses the same formula per lane.
-inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3d& e) {
-  const double w = q.unit(0), x = q.unit(1), y = q.unit(2), z = q.unit(3);
-  const Eigen::Vector4d along_unit(
-      2.0 * (e.x() * w + e.y() * z - e.z() * y), 2.0 * (e.x() * x + e.y() * y + e.z() * z),
-      2.0 * (e.y() * x - e.x() * y - e.z() * w), 2.0 * (e.y() * w + e.z() * x - e.x() * z));
-  return (along_unit - q.unit.dot(along_unit) * q.unit) * q.inverse_norm;
+// e . du/dq for the axis u = Q(q^) e_x of the q as given, times |q|^2 / 2:
+//   e . du/dq = (2 / |q|^2) (B(q)' e - (e . u) q),
+//   B(q)' e = [e_x w + e_y z - e_z y, e_x x + e_y y + e_z z, e_y x - e_x y - e_z w,
+//              e_y w + e_z x - e_x z].
+// Derivation: u = Q(q^) e_x with q^ = q / |q| has du/dq = J(q^) (I - q^ q^') / |q|, where
+// J = d(Q(q^) e_x) / dq^ = 2 B(q^) (B's columns (w, x, y, z) are [w z -y]', [x y z]', [-y x -w]',
+// [-z w x]', valid on the unit sphere where 1 - 2 (y^2 + z^2) = w^2 + x^2 - y^2 - z^2). B is
+// linear and u quadratic in q^, so B(q^) q^ = u and q^ . B(q^)' e = e . u; and B(q^) = B(q) / |q|.
+// The raw q keeps the normalization out: the caller multiplies by 2 / |q|^2 with its own factors.
+// (The batch kernel, capsule_rows.cpp, takes the same derivative from q^ per lane.)
+inline Eigen::Vector4d half_axis_gradient(const Eigen::Vector4d& q, const Eigen::Vector3d& u,
+                                          const Eigen::Vector3d& e) {
+  const double w = q(0), x = q(1), y = q(2), z = q(3);
+  const Eigen::Vector4d along(e.x() * w + e.y() * z - e.z() * y, e.x() * x + e.y() * y + e.z() * z,
+                              e.y() * x - e.x() * y - e.z() * w, e.y() * w + e.z() * x - e.x() * z);
+  return along - e.dot(u) * q;
 }
 
 // In the frame (lengths divided by scale = 2^e, pair_frame.hpp), the capsules' cores are
@@ -97,13 +106,15 @@ inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3
                cos = ux * vx + uy * vy + uz * vz;
   const double across_n =
       (wy * vz - wz * vy) * nx + (wz * vx - wx * vz) * ny + (wx * vy - wy * vx) * nz;  // (w x v).n
-  double s = std::clamp(-across_n / sin2, -h, h);
-  const double t_free = f + s * cos;
+  // s for t held at either end (t is then exactly +-k) is computed beside the free s, off its
+  // path, so that the held case costs one select at the end of the chain rather than a
+  // multiplication, a subtraction and a clamp after t (the query ~7 ns faster, BENCHMARKS.md).
+  const double s_at_end = std::clamp(k * cos - c, -h, h);
+  const double s_at_start = std::clamp(-k * cos - c, -h, h);
+  const double s_for_free_t = std::clamp(-across_n / sin2, -h, h);
+  const double t_free = f + s_for_free_t * cos;
   const double t = std::clamp(t_free, -k, k);
-  // Both candidates computed and one selected: which one applies is a coin toss for random
-  // poses, and a mispredicted branch costs more than the few flops.
-  const double s_clamped = std::clamp(t * cos - c, -h, h);
-  s = t == t_free ? s : s_clamped;
+  const double s = t_free > k ? s_at_end : t_free < -k ? s_at_start : s_for_free_t;
 
   const Eigen::Vector3d D(wx + s * ux - t * vx, wy + s * uy - t * vy, wz + s * uz - t * vz);
   const double D2 = D.x() * D.x() + D.y() * D.y() + D.z() * D.z();
@@ -123,21 +134,27 @@ inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3
 
 // phi = |D|^2 scale^2 - (R_a + R_b)^2 (eq. caps_prox), and by the envelope theorem (eq. dphi;
 // s, t optimal) dphi/dr_a = 2 D scale = -dphi/dr_b, and the quaternion parts are
-// 2 D . dP/dq_a = axis_gradient(q_a, s 2 D) and -axis_gradient(q_b, t 2 D), times scale^2
+// 2 D . s du/dq_a = (4 s / |q_a|^2) half_axis_gradient(q_a, u, D) and
+// -2 D . t dv/dq_b = (-4 t / |q_b|^2) half_axis_gradient(q_b, v, D), times scale^2
 // (pair_result.cpp's restore_units). The normal points from a to b: -D / |D|.
 [[gnu::always_inline]] inline Proximity generic_proximity(const GenericCapsuleSolution& g,
                                                           const Capsule& a, const Pose& pose_a,
                                                           const Capsule& b, const Pose& pose_b) {
   const double scale = g.scale;
   const double radius_sum = a.radius() + b.radius();
-  const Eigen::Vector3d slope = 2.0 * g.D;  // dphi/dD in the frame
   Eigen::Matrix<double, 14, 1> gradient;
-  gradient.segment<3>(0) = slope * scale;
-  // Two products, not scale^2: that loses bits below 2^-511 (a subnormal) and is zero below
-  // 2^-537, where the gradient is neither.
-  gradient.segment<4>(3) = axis_gradient(g.attitude_a, g.s * slope) * scale * scale;
-  gradient.segment<3>(7) = -slope * scale;
-  gradient.segment<4>(10) = -axis_gradient(g.attitude_b, g.t * slope) * scale * scale;
+  const double twice_scale = 2.0 * scale;
+  gradient.segment<3>(0) = g.D * twice_scale;
+  gradient.segment<3>(7) = g.D * -twice_scale;
+  // scale twice as two products, not scale^2: that loses bits below 2^-511 (a subnormal) and is
+  // zero below 2^-537, where the gradient is neither. 1 / |q|^2 is multiplied by the scale first,
+  // as in axis_hessian.
+  const double factor_a = g.attitude_a.inverse_norm2 * scale * (4.0 * g.s);
+  const double factor_b = g.attitude_b.inverse_norm2 * scale * (-4.0 * g.t);
+  gradient.segment<4>(3) =
+      half_axis_gradient(pose_a.q(), g.attitude_a.axis, g.D) * factor_a * scale;
+  gradient.segment<4>(10) =
+      half_axis_gradient(pose_b.q(), g.attitude_b.axis, g.D) * factor_b * scale;
   // The normal by contact_normal.hpp's rule, as the general pipeline takes it: both points
   // inside their segments, D is normal to both axes and the normal is -+(u x v) / |u x v|, exact
   // to ~eps / sin, where D / |D| carries s's rounding, ~eps |w| / (sin^2 |D|) (up to 2e-13 at
@@ -146,8 +163,8 @@ inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3
   const Eigen::Vector3d normal =
       g.edge_normal ? Eigen::Vector3d(g.n * ((g.n.dot(g.D) > 0.0 ? -1.0 : 1.0) / std::sqrt(g.sin2)))
                     : Eigen::Vector3d(g.D * (-1.0 / std::sqrt(g.D2)));
-  const Eigen::Vector3d core_a = pose_a.r() + scale * (g.s * g.attitude_a.axis);
-  const Eigen::Vector3d core_b = pose_b.r() + scale * (g.t * g.attitude_b.axis);
+  const Eigen::Vector3d core_a = pose_a.r() + (scale * g.s) * g.attitude_a.axis;
+  const Eigen::Vector3d core_b = pose_b.r() + (scale * g.t) * g.attitude_b.axis;
   // Every member given: the default member initializers (a zeroed gradient) are not run first.
   return {g.D2 * scale * scale - radius_sum * radius_sum,
           {core_a, core_b},
@@ -157,9 +174,9 @@ inline Eigen::Vector4d axis_gradient(const AxisAttitude& q, const Eigen::Vector3
           gradient};
 }
 
-// du/dq for the unit axis u = Q(q^) e_x of the q as given: J(q^) (I - q^ q^') / |q|, with J's
-// columns as in axis_gradient; J(q^) q^ = 2 u (J is linear in q^ and u quadratic), so this is
-// (J(q^) - 2 u q^') / |q|. Row-major: e' du/dq is a sum of three contiguous rows (axis_rate).
+// du/dq for the unit axis u = Q(q^) e_x of the q as given: J(q^) (I - q^ q^') / |q|, with
+// J = 2 B as in half_axis_gradient; J(q^) q^ = 2 u (J is linear in q^ and u quadratic), so this
+// is (J(q^) - 2 u q^') / |q|. Row-major: e' du/dq is a sum of three contiguous rows (axis_rate).
 using AxisJacobian = Eigen::Matrix<double, 3, 4, Eigen::RowMajor>;
 
 [[gnu::always_inline]] inline AxisJacobian axis_jacobian(const AxisAttitude& q) {
@@ -192,7 +209,8 @@ struct AxisJacobians {
 //       [  0     e_x    e_y   e_z ]
 //       [ -e_z   e_y   -e_x   0   ]
 //       [  e_y   e_z    0    -e_x ]
-// (2 M q^ is axis_gradient's J' e). With G = e . u and g = 2 (M q^ - G q^):
+// (2 M q^ is J(q^)' e = 2 B(q^)' e, half_axis_gradient's B). With G = e . u and g = 2 (M q^ - G
+// q^):
 //   hess = (2 M - 2 G I - 2 q^ g' - 2 g q^') / |q|^2,
 // times `factor`, in units of `scale` twice. 1 / |q| is multiplied by the scale first: 1 / |q|^2
 // spans [2.5e-201, 1e80] and scale^2 [2^-2000, 2^666], so either squared alone, or factor / |q|^2
@@ -275,22 +293,23 @@ struct FreeMotion {
   const RateVectors e = rate_vectors(g);
   r.a << u.transpose(), axis_rate(J.Ju, e.a_qa), axis_rate(J.Jv, e.a_qb);
   r.b << v.transpose(), axis_rate(J.Ju, e.b_qa), axis_rate(J.Jv, e.b_qb);
-  FreeMotion m;
+  // Every case's ds and dt as combinations of a and b, the case choosing four scalars only. Rows
+  // set to zero in some branches were cleared with `rep stos`, a slow start for 88 bytes: ~17%
+  // of the function's samples fell next to it (perf), and without it the Jacobian took 161-175
+  // ns instead of 169-178 (5 paired rounds, BENCHMARKS.md 2026-11-29).
+  double ds_a = 0.0, ds_b = 0.0, dt_a = 0.0, dt_b = 0.0;
   if (g.s_free && g.t_free) {
     const double inverse_sin2 = 1.0 / g.sin2;
-    m.ds = (g.cos * r.b - v.squaredNorm() * r.a) * inverse_sin2;
-    m.dt = (u.squaredNorm() * r.b - g.cos * r.a) * inverse_sin2;
+    ds_a = -v.squaredNorm() * inverse_sin2;
+    ds_b = g.cos * inverse_sin2;
+    dt_a = -g.cos * inverse_sin2;
+    dt_b = u.squaredNorm() * inverse_sin2;
   } else if (g.s_free) {
-    m.ds = -r.a / u.squaredNorm();
-    m.dt.setZero();
+    ds_a = -1.0 / u.squaredNorm();
   } else if (g.t_free) {
-    m.ds.setZero();
-    m.dt = r.b / v.squaredNorm();
-  } else {
-    m.ds.setZero();
-    m.dt.setZero();
+    dt_b = 1.0 / v.squaredNorm();
   }
-  return m;
+  return {ds_a * r.a + ds_b * r.b, dt_a * r.a + dt_b * r.b};
 }
 
 // A 6 x 11 Jacobian of two points over y, in the frame (positions unitless, quaternions in frame
@@ -460,8 +479,12 @@ bool solve_generic_capsules(const Capsule& a, const Pose& pose_a, const Capsule&
 ProximityJacobian generic_capsule_proximity_jacobian(const GenericCapsuleSolution& solution,
                                                      const Capsule& a, const Pose& pose_a,
                                                      const Capsule& b, const Pose& pose_b) {
+  // The axes' Jacobians first: they need the quaternions alone, not s, t or D, so the processor
+  // can form them while the solve's last steps are in flight (in a paired run 181-188 -> 171-182
+  // ns, BENCHMARKS.md 2026-11-29).
+  const AxisJacobians jacobians = axis_jacobians(solution);
   const Proximity first = generic_proximity_outlined(solution, a, pose_a, b, pose_b);
-  const PointsMotion motion = points_motion(solution, axis_jacobians(solution), a, b, first.normal);
+  const PointsMotion motion = points_motion(solution, jacobians, a, b, first.normal);
   return {first, point_columns(motion.core, solution.scale),
           point_columns(motion.surface, solution.scale)};
 }

@@ -37,10 +37,12 @@
 
 namespace diffpills::detail {
 
-// A quaternion q as the fused pass uses it: q^ = q / |q|, 1 / |q| and the body x axis Q(q^) e_x.
+// A quaternion q as the fused pass uses it: q^ = q / |q|, 1 / |q|, 1 / |q|^2 and the body x
+// axis Q(q^) e_x.
 struct AxisAttitude {
   Eigen::Vector4d unit;
   double inverse_norm;
+  double inverse_norm2;
   Eigen::Vector3d axis;
 };
 
