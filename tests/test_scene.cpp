@@ -267,6 +267,58 @@ TEST(Scene, ContactsAreEveryPairWithinTheMarginOfCheckedBodies) {
   EXPECT_GT(compared, 2000);
 }
 
+// world_pose against the Eigen composition above (to rounding), and as the contacts' own
+// geometry: signed_distance at the world poses it gives is every contact's distance, points and
+// normal, bit for bit, and its gradient taken through the chain rule by hand (scene.hpp) is the
+// contact's to rounding.
+TEST(Scene, WorldPoseIsTheContactsGeometry) {
+  Rng rng(37);
+  int compared = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const RandomScene s = random_scene(rng, 12, 1.1);
+    const auto world = [&](int body, int shape) {
+      const Pose& body_pose = s.poses[static_cast<std::size_t>(body)];
+      const Pose& local = s.scene.body(body).shapes()[static_cast<std::size_t>(shape)].pose;
+      const Pose pose = world_pose(body_pose, local);
+      const Pose reference = compose(body_pose, local);
+      EXPECT_LE((pose.r() - reference.r()).norm(), 1e-14 * (1 + body_pose.r().norm()));
+      EXPECT_LE((pose.q() - reference.q()).norm(), 1e-15);
+      return pose;
+    };
+    for (const Contact& c : s.scene.contacts(s.poses, 0.3)) {
+      const Shape& a =
+          s.scene.body(c.bodies[0]).shapes()[static_cast<std::size_t>(c.shapes[0])].shape;
+      const Shape& b =
+          s.scene.body(c.bodies[1]).shapes()[static_cast<std::size_t>(c.shapes[1])].shape;
+      const Pose pose_a = world(c.bodies[0], c.shapes[0]), pose_b = world(c.bodies[1], c.shapes[1]);
+      const SignedDistance sd = signed_distance(a, pose_a, b, pose_b);
+      EXPECT_EQ(sd.distance, c.distance);
+      EXPECT_EQ(sd.points[0], c.points[0]);
+      EXPECT_EQ(sd.points[1], c.points[1]);
+      EXPECT_EQ(sd.normal, c.normal);
+      // d/dr of the body is the primitive's; d/dq_body = (d r_p/dq)' g_r + R(q_l)' g_q, here
+      // through rotation.hpp's rotate_gradient and the conjugate product (R(q_l)' g = g (x) q_l*)
+      // of the unit attitudes, times 1 / |q| for the body's own quaternion.
+      for (int side = 0; side < 2; ++side) {
+        const Pose& body_pose = s.poses[static_cast<std::size_t>(c.bodies[side])];
+        const Pose& local =
+            s.scene.body(c.bodies[side]).shapes()[static_cast<std::size_t>(c.shapes[side])].pose;
+        const Eigen::Matrix<double, 7, 1> g = sd.gradient.segment<7>(7 * side);
+        const Eigen::Vector4d q_l = local.q() / local.q().norm();
+        const Eigen::Vector4d conjugate(q_l(0), -q_l(1), -q_l(2), -q_l(3));
+        const Eigen::Vector4d expected =
+            rotate_gradient(body_pose.q(), local.r(), g.head<3>()) +
+            quaternion_product(g.tail<4>(), conjugate) / body_pose.q().norm();
+        const Eigen::Vector4d found = c.gradient.segment<4>(7 * side + 3);
+        EXPECT_EQ(c.gradient.segment<3>(7 * side), g.head<3>());
+        EXPECT_LE((found - expected).norm(), 1e-12 * (1 + expected.norm()));
+      }
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 100);
+}
+
 // The whole scene moved rigidly (every body pose composed with one motion): the same contacts,
 // the points moved with it.
 TEST(Scene, RigidMotionOfTheWholeScene) {

@@ -302,8 +302,8 @@ Eigen::MatrixXd ArmShelfProblem::dynamics_hessian(const State&, const Control&,
 }
 
 // Each shape's world pose is fixed in its link's frame f (or in the world, for a board):
-// p = o_f + Q(q_f) r_l, q_p = q_f (x) q_l / |q_l|, as the scene composes it up to rounding (the
-// scene normalizes q_f first). With J_s its
+// p = o_f + Q(q_f) r_l, q_p = q_f^ (x) q_l / |q_l| (world_pose, scene.hpp: the scene's own
+// composition, bit for bit, so the Hessian is taken at the contact's geometry). With J_s its
 // Jacobian and C_s its curvature term for the distance's gradient (serial_chain.hpp), the Hessian
 // of the distance in the joint angles is [J_1; J_2]' H [J_1; J_2] + C_1 + C_2, H the 14 x 14
 // Hessian of signed_distance_hessian at the two world poses.
@@ -312,13 +312,11 @@ Eigen::MatrixXd ArmShelfProblem::contact_hessian(const Contact& contact,
   std::array<Pose, 2> world;
   for (std::size_t side = 0; side < 2; ++side) {
     const BodyShape& shape = scene_.body(contact.bodies[side]).shapes()[contact.shapes[side]];
-    const Eigen::Vector4d local_attitude = shape.pose.q() / shape.pose.q().norm();
     if (contact.bodies[side] >= 1 && contact.bodies[side] < kLinks) {
       const auto f = static_cast<std::size_t>(contact.bodies[side]);
-      world[side] = Pose(frames.origin[f] + rotation_matrix(frames.attitude[f]) * shape.pose.r(),
-                         quaternion_product(frames.attitude[f], local_attitude));
+      world[side] = world_pose(Pose(frames.origin[f], frames.attitude[f]), shape.pose);
     } else {
-      world[side] = Pose(shape.pose.r(), local_attitude);  // the base and the boards stay put
+      world[side] = world_pose(Pose(), shape.pose);  // the base and the boards stay put
     }
   }
   const auto& shape_of = [&](std::size_t side) -> const Shape& {

@@ -48,12 +48,6 @@ void draw(Svg& svg, const View& view, const Shape& shape, const Pose& pose,
   svg.polygon(outline, polygon.radius(), color, opacity);
 }
 
-// A primitive's world pose on a body at `body`.
-Pose compose(const Pose& body, const Pose& local) {
-  return Pose(body.r() + rotation_matrix(body.q()) * local.r(),
-              quaternion_product(body.q(), local.q()));
-}
-
 }  // namespace
 
 ArmShelfRun solve_arm_shelf(const ArmShelfProblem& problem, const DemoSettings& settings) {
@@ -161,7 +155,7 @@ void write_arm_shelf_svg(const ArmShelfProblem& problem, const ArmShelfRun& run,
       const std::vector<Pose> poses = arm_shelf_poses(s, states[knots[i]]);
       for (std::size_t f = 0; f < s.arm.links.size(); ++f) {
         for (const BodyShape& shape : s.arm.links[f]) {
-          draw(svg, view, shape.shape, compose(poses[f], shape.pose), colours[i], 0.3);
+          draw(svg, view, shape.shape, world_pose(poses[f], shape.pose), colours[i], 0.3);
         }
       }
     }

@@ -162,4 +162,12 @@ class Scene {
       outlines_;  // immutable, shared by copies, never null
 };
 
+// The world pose of a primitive fixed at `local` on a body at `body` ("Chain rule" above):
+// r + Q(q) r_l with the unit attitude q^ (x) q_l / |q_l| (q^ = q / |q|; the unit quaternion is
+// always a valid Pose, where q (x) q_l could leave Pose's range). Scene::contacts poses every
+// primitive so, bit for bit: a caller that queries a contact's pair again (for
+// signed_distance_hessian, for a drawing) gets the contact's own geometry. Throws
+// std::invalid_argument (Pose's message) if the position is beyond 1e100 in magnitude.
+Pose world_pose(const Pose& body, const Pose& local);
+
 }  // namespace diffpills

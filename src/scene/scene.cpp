@@ -23,11 +23,9 @@
 namespace diffpills {
 namespace {
 
-// A primitive's world pose: r + Q(q) r_l, and the unit quaternion q^ (x) q_l / |q_l| (q^ the
-// body's attitude normalized once per query by the broadphase): q (x) q_l itself is as good an
-// attitude, but its entries could exceed 1e100 (or its norm fall below 1e-40) where q's and q_l's
-// do not, and the unit one is always a valid Pose. (The broadphase checked r + Q(q) r_l.)
-Pose world_pose(const Pose& body_pose, const detail::UnitQuaternion& attitude, const Pose& local) {
+// A primitive's world pose (world_pose in scene.hpp) from its body's attitude normalized once per
+// query by the broadphase.
+Pose posed(const Pose& body_pose, const detail::UnitQuaternion& attitude, const Pose& local) {
   return Pose(body_pose.r() + attitude.matrix() * local.r(),
               quaternion_product(attitude.unit(), local.q() / local.q().norm()));
 }
@@ -59,6 +57,14 @@ double radius_of(const Shape& shape) {
 }
 
 }  // namespace
+
+// r + Q(q) r_l and q^ (x) q_l / |q_l|, q^ = q / |q|: q (x) q_l itself is as good an attitude, but
+// its entries could exceed 1e100 (or its norm fall below 1e-40) where q's and q_l's do not, and
+// the unit one is always a valid Pose. (The broadphase checked r + Q(q) r_l for the scene's
+// primitives; a caller's is checked by Pose.)
+Pose world_pose(const Pose& body, const Pose& local) {
+  return posed(body, detail::UnitQuaternion(body.q()), local);
+}
 
 BodyPoseError::BodyPoseError(int body, const std::string& body_name, int shape, std::string reason)
     : std::invalid_argument("body_poses[" + std::to_string(body) + "] (body '" +
@@ -163,7 +169,7 @@ std::vector<Contact> Scene::contacts(const std::vector<Pose>& body_poses, double
   const std::vector<std::pair<int, int>> pairs =
       detail::broadphase(*this, *outlines_, body_poses, margin, attitudes);
   // A primitive in several pairs (a robot's link beside every board of a shelf) is posed once per
-  // query: world_pose normalizes the local quaternion, composes and checks the result.
+  // query: posed normalizes the local quaternion, composes and checks the result.
   std::vector<std::optional<Pose>> world(outlines_->primitives.size());
   const auto world_of = [&](int primitive) -> const Pose& {
     std::optional<Pose>& pose = world[static_cast<std::size_t>(primitive)];
@@ -171,8 +177,8 @@ std::vector<Contact> Scene::contacts(const std::vector<Pose>& body_poses, double
       const detail::SceneOutlines::Primitive& p =
           outlines_->primitives[static_cast<std::size_t>(primitive)];
       const auto owner = static_cast<std::size_t>(p.body);
-      pose = world_pose(body_poses[owner], attitudes[owner],
-                        body(p.body).shapes()[static_cast<std::size_t>(p.shape)].pose);
+      pose = posed(body_poses[owner], attitudes[owner],
+                   body(p.body).shapes()[static_cast<std::size_t>(p.shape)].pose);
     }
     return *pose;
   };
