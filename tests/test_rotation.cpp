@@ -110,7 +110,10 @@ TEST(Rotation, HessianMatchesCentralDifferencesOfTheGradient) {
   }
 }
 
-TEST(Rotation, LeftAndRightMultiplyAndAttitudeJacobian) {
+// The product three ways (left and right multiplication matrices, quaternion_product) against
+// Eigen's product; quaternion_product as a composition of rotations, Q(q (x) p) = Q(q) Q(p) (the
+// scene composes a primitive's attitude on its body's so); and the attitude Jacobian.
+TEST(Rotation, QuaternionProductsAndAttitudeJacobian) {
   Rng rng(3);
   for (int i = 0; i < 500; ++i) {
     const Eigen::Vector4d q = random_quaternion(rng);
@@ -120,6 +123,17 @@ TEST(Rotation, LeftAndRightMultiplyAndAttitudeJacobian) {
     const Eigen::Vector4d expected(product.w(), product.x(), product.y(), product.z());
     EXPECT_LE((left_multiply_matrix(q) * p - expected).norm(), 1e-13);
     EXPECT_LE((right_multiply_matrix(p) * q - expected).norm(), 1e-13);  // Eigen's product
+    const Eigen::Vector4d qp = quaternion_product(q, p);
+    EXPECT_LE((qp - expected).norm(), 1e-13 * q.norm() * p.norm());
+    EXPECT_LE((rotation_matrix(qp) - rotation_matrix(q) * rotation_matrix(p)).cwiseAbs().maxCoeff(),
+              1e-14);
+    // R(p)' q = q (x) p*, which the scene's chain rule takes through a composed attitude.
+    const Eigen::Vector4d conjugate(p(0), -p(1), -p(2), -p(3));
+    EXPECT_LE((quaternion_product(q, conjugate) - right_multiply_matrix(p).transpose() * q).norm(),
+              1e-13 * q.norm() * p.norm());
+    // rotation_matrix builds the matrix alone, with the same bits as the attitude the scene and
+    // the pairs keep (their broadphase boxes and world poses must agree exactly).
+    EXPECT_EQ(rotation_matrix(q), detail::UnitQuaternion(q).matrix());
     // dq/dtheta of q (x) [1, theta/2] is 1/2 G(q).
     const Eigen::Matrix<double, 4, 3> G = attitude_jacobian(q);
     for (int j = 0; j < 3; ++j) {
@@ -131,30 +145,6 @@ TEST(Rotation, LeftAndRightMultiplyAndAttitudeJacobian) {
           (left_multiply_matrix(q) * bump - left_multiply_matrix(q) * back) / 2e-6;
       EXPECT_LE((0.5 * G.col(j) - fd).norm(), 1e-9);
     }
-  }
-}
-
-// quaternion_product against Eigen's product, and as a composition of rotations:
-// Q(a (x) b) = Q(a) Q(b) (the scene composes a primitive's attitude on its body's so).
-TEST(Rotation, QuaternionProductIsEigensAndComposesRotations) {
-  Rng rng(7);
-  for (int i = 0; i < 500; ++i) {
-    const Eigen::Vector4d a = random_quaternion(rng);
-    const Eigen::Vector4d b = random_quaternion(rng);
-    const Eigen::Quaterniond product =
-        Eigen::Quaterniond(a(0), a(1), a(2), a(3)) * Eigen::Quaterniond(b(0), b(1), b(2), b(3));
-    const Eigen::Vector4d expected(product.w(), product.x(), product.y(), product.z());
-    const Eigen::Vector4d ab = quaternion_product(a, b);
-    EXPECT_LE((ab - expected).norm(), 1e-13 * a.norm() * b.norm());
-    EXPECT_LE((rotation_matrix(ab) - rotation_matrix(a) * rotation_matrix(b)).cwiseAbs().maxCoeff(),
-              1e-14);
-    // R(b)' p = p (x) b*, which the scene's chain rule takes through a composed attitude.
-    const Eigen::Vector4d conjugate(b(0), -b(1), -b(2), -b(3));
-    EXPECT_LE((quaternion_product(a, conjugate) - right_multiply_matrix(b).transpose() * a).norm(),
-              1e-13 * a.norm() * b.norm());
-    // rotation_matrix builds the matrix alone, with the same bits as the attitude the scene and
-    // the pairs keep (their broadphase boxes and world poses must agree exactly).
-    EXPECT_EQ(rotation_matrix(a), detail::UnitQuaternion(a).matrix());
   }
 }
 
