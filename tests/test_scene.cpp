@@ -279,7 +279,7 @@ TEST(Scene, WorldPoseIsTheContactsGeometry) {
     const auto world = [&](int body, int shape) {
       const Pose& body_pose = s.poses[static_cast<std::size_t>(body)];
       const Pose& local = s.scene.body(body).shapes()[static_cast<std::size_t>(shape)].pose;
-      const Pose pose = world_pose(body_pose, local);
+      Pose pose = world_pose(body_pose, local);
       const Pose reference = compose(body_pose, local);
       EXPECT_LE((pose.r() - reference.r()).norm(), 1e-14 * (1 + body_pose.r().norm()));
       EXPECT_LE((pose.q() - reference.q()).norm(), 1e-15);
@@ -299,18 +299,19 @@ TEST(Scene, WorldPoseIsTheContactsGeometry) {
       // d/dr of the body is the primitive's; d/dq_body = (d r_p/dq)' g_r + R(q_l)' g_q, here
       // through rotation.hpp's rotate_gradient and the conjugate product (R(q_l)' g = g (x) q_l*)
       // of the unit attitudes, times 1 / |q| for the body's own quaternion.
-      for (int side = 0; side < 2; ++side) {
+      for (std::size_t side = 0; side < 2; ++side) {
+        const Eigen::Index offset = 7 * static_cast<Eigen::Index>(side);
         const Pose& body_pose = s.poses[static_cast<std::size_t>(c.bodies[side])];
         const Pose& local =
             s.scene.body(c.bodies[side]).shapes()[static_cast<std::size_t>(c.shapes[side])].pose;
-        const Eigen::Matrix<double, 7, 1> g = sd.gradient.segment<7>(7 * side);
+        const Eigen::Matrix<double, 7, 1> g = sd.gradient.segment<7>(offset);
         const Eigen::Vector4d q_l = local.q() / local.q().norm();
         const Eigen::Vector4d conjugate(q_l(0), -q_l(1), -q_l(2), -q_l(3));
         const Eigen::Vector4d expected =
             rotate_gradient(body_pose.q(), local.r(), g.head<3>()) +
             quaternion_product(g.tail<4>(), conjugate) / body_pose.q().norm();
-        const Eigen::Vector4d found = c.gradient.segment<4>(7 * side + 3);
-        EXPECT_EQ(c.gradient.segment<3>(7 * side), g.head<3>());
+        const Eigen::Vector4d found = c.gradient.segment<4>(offset + 3);
+        EXPECT_EQ(c.gradient.segment<3>(offset), g.head<3>());
         EXPECT_LE((found - expected).norm(), 1e-12 * (1 + expected.norm()));
       }
       ++compared;
