@@ -3,7 +3,7 @@
 // signed_distance(...) for signed_distance_batch). Bit for bit, except for two capsules (by the
 // default method): their rows go through a vector kernel, several pairs per instruction (Google
 // Highway, AVX-512 / AVX2 / SSE4 / plain code chosen at run time; 12-31 ns per pair and thread,
-// with the machine and the batch's size, against 50-75 ns for the single call and 130-190 ns for
+// with the machine and the batch's size, against 50-58 ns for the single call and 130-190 ns for
 // its signed distance), which agrees with the single call to rounding: phi within 1e-12 S^2, the
 // signed distance within 1e-12 S, gradients within the same per length and per unit of q, S the
 // scene's size (the largest of the lengths, the radii's sum and the distance between the

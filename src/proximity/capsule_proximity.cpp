@@ -34,9 +34,10 @@ bool frame_exponent(double size, int& exponent) {
 //   u = Q(q^) e_x = A(q) / |q|^2,  A(q) = [w^2 + x^2 - y^2 - z^2, 2 (x y + w z), 2 (x z - w y)]
 // (the first column of unit_quaternion.cpp's Q, each entry quadratic in q). From the raw q the
 // axis takes one division on the way to s, where normalizing q first put a square root and a
-// division there. q^ and 1 / |q| (the Jacobians' and the Hessian's) come from the same 1 / |q|^2
-// off that path, and proximity() drops them. Forced inline: as a call, returning the struct
-// through memory, the query took ~3 ns longer (BENCHMARKS.md, 2026-11-29).
+// division there. q^ and 1 / |q| (the gradient's, the Jacobians' and the Hessian's) come from the
+// same 1 / |q|^2 off that path: they are needed only once the closest points are known. Forced
+// inline: as a call, returning the struct through memory, the query took ~3 ns longer
+// (BENCHMARKS.md, 2026-11-29).
 [[gnu::always_inline]] inline AxisAttitude axis_attitude(const Eigen::Vector4d& q) {
   // Pose keeps |q| within [1e-40, 2e100], so |q|^2 neither underflows nor overflows.
   const double w = q(0), x = q(1), y = q(2), z = q(3);
@@ -44,25 +45,28 @@ bool frame_exponent(double size, int& exponent) {
   const double inverse_norm = std::sqrt(inverse_norm2);
   const Eigen::Vector3d quadratic(w * w + x * x - y * y - z * z, 2.0 * (x * y + w * z),
                                   2.0 * (x * z - w * y));
-  return {q * inverse_norm, inverse_norm, inverse_norm2, quadratic * inverse_norm2};
+  return {q * inverse_norm, inverse_norm, quadratic * inverse_norm2};
 }
 
-// e . du/dq for the axis u = Q(q^) e_x of the q as given, times |q|^2 / 2:
-//   e . du/dq = (2 / |q|^2) (B(q)' e - (e . u) q),
-//   B(q)' e = [e_x w + e_y z - e_z y, e_x x + e_y y + e_z z, e_y x - e_x y - e_z w,
-//              e_y w + e_z x - e_x z].
+// Half the derivative of e . u over the unit quaternion q^, projected onto the sphere's tangent
+// plane at q^, for the axis u = Q(q^) e_x:
+//   T(q^, u, e) = B(q^)' e - (e . u) q^,
+//   B(q^)' e = [e_x w + e_y z - e_z y, e_x x + e_y y + e_z z, e_y x - e_x y - e_z w,
+//               e_y w + e_z x - e_x z]   (w, x, y, z the components of q^),
+// so that for the q as given e . du/dq = (2 / |q|) T.
 // Derivation: u = Q(q^) e_x with q^ = q / |q| has du/dq = J(q^) (I - q^ q^') / |q|, where
 // J = d(Q(q^) e_x) / dq^ = 2 B(q^) (B's columns (w, x, y, z) are [w z -y]', [x y z]', [-y x -w]',
 // [-z w x]', valid on the unit sphere where 1 - 2 (y^2 + z^2) = w^2 + x^2 - y^2 - z^2). B is
-// linear and u quadratic in q^, so B(q^) q^ = u and q^ . B(q^)' e = e . u; and B(q^) = B(q) / |q|.
-// The raw q keeps the normalization out: the caller multiplies by 2 / |q|^2 with its own factors.
-// (The batch kernel, capsule_rows.cpp, takes the same derivative from q^ per lane.)
-inline Eigen::Vector4d half_axis_gradient(const Eigen::Vector4d& q, const Eigen::Vector3d& u,
-                                          const Eigen::Vector3d& e) {
-  const double w = q(0), x = q(1), y = q(2), z = q(3);
+// linear and u quadratic in q^, so B(q^) q^ = u and q^ . B(q^)' e = e . u. T is of the size of
+// |e| whatever |q| is; the caller multiplies by 2 / |q| with its own factors. (The batch kernel,
+// capsule_rows.cpp, takes the same derivative per lane.)
+inline Eigen::Vector4d half_tangent_axis_gradient(const Eigen::Vector4d& unit,
+                                                  const Eigen::Vector3d& u,
+                                                  const Eigen::Vector3d& e) {
+  const double w = unit(0), x = unit(1), y = unit(2), z = unit(3);
   const Eigen::Vector4d along(e.x() * w + e.y() * z - e.z() * y, e.x() * x + e.y() * y + e.z() * z,
                               e.y() * x - e.x() * y - e.z() * w, e.y() * w + e.z() * x - e.x() * z);
-  return along - e.dot(u) * q;
+  return along - e.dot(u) * unit;
 }
 
 // In the frame (lengths divided by scale = 2^e, pair_frame.hpp), the capsules' cores are
@@ -109,10 +113,25 @@ inline Eigen::Vector4d half_axis_gradient(const Eigen::Vector4d& q, const Eigen:
   // s for t held at either end (t is then exactly +-k) is computed beside the free s, off its
   // path, so that the held case costs one select at the end of the chain rather than a
   // multiplication, a subtraction and a clamp after t (the query ~7 ns faster, BENCHMARKS.md).
-  const double s_at_end = std::clamp(k * cos - c, -h, h);
-  const double s_at_start = std::clamp(-k * cos - c, -h, h);
-  const double s_for_free_t = std::clamp(-across_n / sin2, -h, h);
+  const double s_for_end = k * cos - c, s_for_start = -k * cos - c, s_star = -across_n / sin2;
+  const double s_at_end = std::clamp(s_for_end, -h, h);
+  const double s_at_start = std::clamp(s_for_start, -h, h);
+  const double s_for_free_t = std::clamp(s_star, -h, h);
   const double t_free = f + s_for_free_t * cos;
+  // Ties: a clamp decided by less than 2^-36 of the frame's unit (the quantities clamped err by
+  // ~1e-13 of it, in either path; the frame's size is below 2 sqrt(3)). The points barely depend
+  // on the side taken, but their Jacobians and phi's Hessian do: they are one-sided there, and a
+  // core shorter than the axes' rounding (2e-81 long, 3 away: a finding of fuzz_proximity) is a
+  // tie along its whole length. Left to the general pipeline, so that both paths answer a tie
+  // the same way. The clamps: s* to [-h, h], t for it to [-k, k], and, when t is held at an
+  // end, s for that end to [-h, h].
+  const auto near_bound = [](double value, double bound) {
+    return std::abs(std::abs(value) - bound) < 0x1p-36;
+  };
+  if (near_bound(s_star, h) || near_bound(t_free, k) ||
+      (t_free > k && near_bound(s_for_end, h)) || (t_free < -k && near_bound(s_for_start, h))) {
+    return false;
+  }
   const double t = std::clamp(t_free, -k, k);
   const double s = t_free > k ? s_at_end : t_free < -k ? s_at_start : s_for_free_t;
 
@@ -134,8 +153,8 @@ inline Eigen::Vector4d half_axis_gradient(const Eigen::Vector4d& q, const Eigen:
 
 // phi = |D|^2 scale^2 - (R_a + R_b)^2 (eq. caps_prox), and by the envelope theorem (eq. dphi;
 // s, t optimal) dphi/dr_a = 2 D scale = -dphi/dr_b, and the quaternion parts are
-// 2 D . s du/dq_a = (4 s / |q_a|^2) half_axis_gradient(q_a, u, D) and
-// -2 D . t dv/dq_b = (-4 t / |q_b|^2) half_axis_gradient(q_b, v, D), times scale^2
+// 2 D . s du/dq_a = (4 s / |q_a|) half_tangent_axis_gradient(q_a^, u, D) and
+// -2 D . t dv/dq_b = (-4 t / |q_b|) half_tangent_axis_gradient(q_b^, v, D), times scale^2
 // (pair_result.cpp's restore_units). The normal points from a to b: -D / |D|.
 [[gnu::always_inline]] inline Proximity generic_proximity(const GenericCapsuleSolution& g,
                                                           const Capsule& a, const Pose& pose_a,
@@ -146,15 +165,21 @@ inline Eigen::Vector4d half_axis_gradient(const Eigen::Vector4d& q, const Eigen:
   const double twice_scale = 2.0 * scale;
   gradient.segment<3>(0) = g.D * twice_scale;
   gradient.segment<3>(7) = g.D * -twice_scale;
-  // scale twice as two products, not scale^2: that loses bits below 2^-511 (a subnormal) and is
-  // zero below 2^-537, where the gradient is neither. 1 / |q|^2 is multiplied by the scale first,
-  // as in axis_hessian.
-  const double factor_a = g.attitude_a.inverse_norm2 * scale * (4.0 * g.s);
-  const double factor_b = g.attitude_b.inverse_norm2 * scale * (-4.0 * g.t);
+  // The factor 4 s scale^2 / |q| as (4 s scale) (scale / |q|): 4 s scale is the offset in the
+  // inputs' units, scale / |q| within [5e-101, 1e40] times the scale, and either one leaves the
+  // normal range only where the entry does (|T| <= |D| < 4 in the frame) or where the closest
+  // point is within 2^-1022 (absolute) of the middle. Each product scales by exactly 2^k or 2^2k
+  // with the scene, so the gradient does too while every product is a normal number (an entry
+  // within a few ulps of 2^-1022 may differ by one). T is of the size of D at any |q|; the two
+  // hostile reviews found (a) |q| T times 4 s / |q|^2 scale scale 0 at |q| = 1e100 and s = 1e-150
+  // of a unit scene, where the entry is 2e-250, and (b) 4 s / |q| formed first 0 at |q| = 1e100,
+  // s = 1e-250 of a 2^330 scene, where the entry is 3e-151.
+  const double factor_a = (4.0 * g.s * scale) * (scale * g.attitude_a.inverse_norm);
+  const double factor_b = (-4.0 * g.t * scale) * (scale * g.attitude_b.inverse_norm);
   gradient.segment<4>(3) =
-      half_axis_gradient(pose_a.q(), g.attitude_a.axis, g.D) * factor_a * scale;
+      half_tangent_axis_gradient(g.attitude_a.unit, g.attitude_a.axis, g.D) * factor_a;
   gradient.segment<4>(10) =
-      half_axis_gradient(pose_b.q(), g.attitude_b.axis, g.D) * factor_b * scale;
+      half_tangent_axis_gradient(g.attitude_b.unit, g.attitude_b.axis, g.D) * factor_b;
   // The normal by contact_normal.hpp's rule, as the general pipeline takes it: both points
   // inside their segments, D is normal to both axes and the normal is -+(u x v) / |u x v|, exact
   // to ~eps / sin, where D / |D| carries s's rounding, ~eps |w| / (sin^2 |D|) (up to 2e-13 at
@@ -175,8 +200,9 @@ inline Eigen::Vector4d half_axis_gradient(const Eigen::Vector4d& q, const Eigen:
 }
 
 // du/dq for the unit axis u = Q(q^) e_x of the q as given: J(q^) (I - q^ q^') / |q|, with
-// J = 2 B as in half_axis_gradient; J(q^) q^ = 2 u (J is linear in q^ and u quadratic), so this
-// is (J(q^) - 2 u q^') / |q|. Row-major: e' du/dq is a sum of three contiguous rows (axis_rate).
+// J = 2 B as in half_tangent_axis_gradient; J(q^) q^ = 2 u (J is linear in q^ and u quadratic),
+// so this is (J(q^) - 2 u q^') / |q|. Row-major: e' du/dq is a sum of three contiguous rows
+// (axis_rate).
 using AxisJacobian = Eigen::Matrix<double, 3, 4, Eigen::RowMajor>;
 
 [[gnu::always_inline]] inline AxisJacobian axis_jacobian(const AxisAttitude& q) {
@@ -209,19 +235,18 @@ struct AxisJacobians {
 //       [  0     e_x    e_y   e_z ]
 //       [ -e_z   e_y   -e_x   0   ]
 //       [  e_y   e_z    0    -e_x ]
-// (2 M q^ is J(q^)' e = 2 B(q^)' e, half_axis_gradient's B). With G = e . u and g = 2 (M q^ - G
-// q^):
+// (2 M q^ is J(q^)' e = 2 B(q^)' e, half_tangent_axis_gradient's B). With G = e . u and
+//   g = 2 (M q^ - G q^):
 //   hess = (2 M - 2 G I - 2 q^ g' - 2 g q^') / |q|^2,
 // times `factor`, in units of `scale` twice. 1 / |q| is multiplied by the scale first: 1 / |q|^2
 // spans [2.5e-201, 1e80] and scale^2 [2^-2000, 2^666], so either squared alone, or factor / |q|^2
 // for a small factor (a short capsule's s), may leave the normal range where the entry does not
 // (a hostile review: |q| = 1e100 and s = 1e-25 of a 1e99 scene lost the block); (1 / |q|) scale
 // is within the inputs' range, and the bracket is at most a few units, so where f underflows the
-// entry does. Each entry below the
-// diagonal is formed once and mirrored, so the block is exactly symmetric. G is taken as e . u
-// from the axis this pass already has, where rotate_hessian forms q^' M q^ (the same on the unit
-// sphere, to rounding); UnitQuaternion itself needs the full rotation matrix and its
-// rotation-vector map, which this pass does not build.
+// entry does. Each entry below the diagonal is formed once and mirrored, so the block is exactly
+// symmetric. G is taken as e . u from the axis this pass already has, where rotate_hessian forms
+// q^' M q^ (the same on the unit sphere, to rounding); UnitQuaternion itself needs the full
+// rotation matrix and its rotation-vector map, which this pass does not build.
 [[gnu::always_inline]] inline Eigen::Matrix4d axis_hessian(const AxisAttitude& q,
                                                            const Eigen::Vector3d& e, double factor,
                                                            double scale) {

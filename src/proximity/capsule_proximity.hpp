@@ -17,6 +17,9 @@
 //   - the axes more than ~5.7 degrees from parallel (sin^2 > 1e-2): nearer parallel the closest
 //     points are sensitive to the axes' rounding (~eps / sin^2), and the general pipeline's
 //     near-parallel regimes compare candidates instead;
+//   - no clamp decided within 2^-36 2^e of its bound (an end of a core; the whole of a core
+//     shorter than 2^-35 2^e whose closest point is inside it): the two paths' rounding may take
+//     different sides of such a tie, where the points' Jacobians and phi's Hessian are one-sided;
 //   - the cores apart by more than 1e-2 2^e (nearer, the general pipeline takes the normal from
 //     the features there, and decides intersection). The normal follows contact_normal.hpp's rule
 //     as the general pipeline does: -+(u x v) / |u x v| for two points inside their segments
@@ -37,12 +40,10 @@
 
 namespace diffpills::detail {
 
-// A quaternion q as the fused pass uses it: q^ = q / |q|, 1 / |q|, 1 / |q|^2 and the body x
-// axis Q(q^) e_x.
+// A quaternion q as the fused pass uses it: q^ = q / |q|, 1 / |q| and the body x axis Q(q^) e_x.
 struct AxisAttitude {
   Eigen::Vector4d unit;
   double inverse_norm;
-  double inverse_norm2;
   Eigen::Vector3d axis;
 };
 
