@@ -23,7 +23,8 @@ Shapes: ``Capsule(length, radius)`` and ``PaddedPolygon(C, d, radius)``, each po
 ``Body(name, [(shape, pose), ...])`` and ``Scene(bodies, exclude)``
     rigid sets of primitives and scenes of named bodies; ``scene.contacts(r, q, margin)`` returns
     every pair of shapes of two bodies within the margin, with gradients with respect to the
-    body poses, as NumPy arrays (a ``Contacts`` named tuple).
+    body poses, as NumPy arrays (a ``Contacts`` named tuple). ``world_pose(body, local)`` poses a
+    shape as the query does, so that a contact's pair can be asked again.
 
 ``phi = ||p1 - p2||^2 - (R1 + R2)^2`` is negative exactly when the shapes overlap. Bad input raises
 ValueError (a bad value or shape) or TypeError (a wrong type: complex numbers, a str, a tensor that
@@ -62,6 +63,7 @@ from ._core import (
     signed_distance_hessian,
     signed_distance_jacobian,
     signed_distance_shape_gradient,
+    world_pose,
 )
 
 __all__ = [
@@ -93,6 +95,7 @@ __all__ = [
     "signed_distance_hessian",
     "signed_distance_jacobian",
     "signed_distance_shape_gradient",
+    "world_pose",
 ]
 
 

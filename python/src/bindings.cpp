@@ -1216,6 +1216,21 @@ poses (chain rule through the shapes' local poses, quaternion normalization incl
                         const py::tuple fields = pickled_state(state, 2, "(bodies, exclude)");
                         return scene_from(fields[0], fields[1]);
                       }));
+  m.def(
+      "world_pose",
+      [](const py::handle& body, const py::handle& local) {
+        const Pose& body_pose = to_pose(body, "body");
+        const Pose& local_pose = to_pose(local, "local");
+        try {
+          return world_pose(body_pose, local_pose);
+        } catch (const std::invalid_argument& error) {  // the composed position beyond 1e100
+          throw py::value_error(std::string("body, local: the world pose's ") + error.what());
+        }
+      },
+      py::arg("body"), py::arg("local"),
+      R"(The world pose of a shape fixed at pose `local` on a body at pose `body`: r + R(q) r_local
+with the unit attitude q/|q| (x) q_local/|q_local|, bit for bit as Scene.contacts poses its
+shapes, so that a contact's pair can be queried again at its own geometry.)");
 }
 
 }  // namespace

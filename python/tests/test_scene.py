@@ -175,6 +175,28 @@ def test_pickling_keeps_the_scene():
         assert (body.name, body.category, body.mask) == ("body1", 2, 0xFFFFFFFD)
 
 
+def test_world_pose_is_the_contacts_geometry():
+    """world_pose against the composition written here (to rounding), and each contact's pair
+    asked again at world_pose's poses: the contact's distance and points, bit for bit."""
+    rng = np.random.default_rng(21)
+    scene, r, q = random_scene(rng, 8, 0.6)
+    found = scene.contacts(r, q, 0.2)
+    assert len(found.distance) > 3
+    for k in range(len(found.distance)):
+        posed = []
+        for side in range(2):
+            body, shape = found.bodies[k][side], found.shapes[k][side]
+            shape_object, local = scene.bodies[body].shapes[shape]
+            pose = diffpills.world_pose(diffpills.Pose(r[body], q[body]), local)
+            attitude = quaternion_product(q[body] / np.linalg.norm(q[body]), local.q / np.linalg.norm(local.q))
+            np.testing.assert_allclose(pose.r, r[body] + rotate(q[body], local.r), rtol=0, atol=1e-14)
+            np.testing.assert_allclose(pose.q, attitude, rtol=0, atol=1e-15)
+            posed.append((shape_object, pose))
+        again = diffpills.signed_distance(posed[0][0], posed[0][1], posed[1][0], posed[1][1])
+        assert again.distance == found.distance[k]
+        assert np.array_equal(again.points, found.points[k])
+
+
 def test_errors_name_the_field():
     stick = diffpills.Capsule(1.0, 0.1)
     good = diffpills.Body("a", [(stick, diffpills.Pose())])
@@ -199,6 +221,10 @@ def test_errors_name_the_field():
         (lambda: diffpills.Scene([good]).contacts([[0, 0, 0]], [[1, 0, 0, 0]], margin=np.inf), ValueError, "margin: must be finite"),
         (lambda: diffpills.Scene([good]).contacts([[0, 0, 0]], [[1, 0, 0, 0]], margin="x"), TypeError, "margin"),
         (lambda: diffpills.Scene.__new__(diffpills.Scene).contacts([], []), TypeError, "made by __new__"),
+        (lambda: diffpills.world_pose(1, diffpills.Pose()), TypeError, "body: expected diffpills.Pose"),
+        (lambda: diffpills.world_pose(diffpills.Pose(), None), TypeError, "local: expected diffpills.Pose"),
+        (lambda: diffpills.world_pose(diffpills.Pose([1e100, 0, 0], [1, 0, 0, 0]), diffpills.Pose([1e100, 0, 0], [1, 0, 0, 0])),
+         ValueError, r"^body, local: the world pose's pose.r\[0\]: magnitude must be <= 1e100"),
         (lambda: far_scene.contacts([[1e100, 0, 0]], [[1, 0, 0, 0]]), ValueError,
          r"^r\[0\] and q\[0\] \(body 'far'\), shape 0: its world position is beyond 1e100"),
     ]
