@@ -349,6 +349,8 @@ TEST(Trajopt, RefusesConstraintsThatBreakTheRowRules) {
 
 // constraint_values is read where no derivatives follow: the polish's trial steps (the line search
 // evaluates constraints). Values with more rows than the knot's are refused there too.
+// CarBusProblem writes its rows in place, so a class changing constraint_values takes the default
+// write_constraints back (problem.hpp).
 class CarBusWithExtraValues : public examples::CarBusProblem {
  public:
   using CarBusProblem::CarBusProblem;
@@ -357,6 +359,12 @@ class CarBusWithExtraValues : public examples::CarBusProblem {
     c.value.conservativeResize(c.value.size() + 3);
     c.value.tail(3).setConstant(-1.0);
     return c;
+  }
+  void write_constraints(int k, const State& x, const Control& u, bool derivatives,
+                         Constraints& out) const override {
+    // The default, skipping CarBusProblem's in-place rows on purpose.
+    // NOLINTNEXTLINE(bugprone-parent-virtual-call)
+    ProblemOf<5, 2>::write_constraints(k, x, u, derivatives, out);
   }
 };
 

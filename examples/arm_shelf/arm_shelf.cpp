@@ -196,14 +196,18 @@ ArmShelfProblem::Cost ArmShelfProblem::terminal_cost(const State&) const {
 ArmShelfProblem::Constraints ArmShelfProblem::constraints(int k, const State& x,
                                                           const Control& u) const {
   Constraints out;
-  write_constraints(k, x, u, true, out);
+  // By name, not virtually: a derived class may override write_constraints with the default,
+  // which calls this function.
+  ArmShelfProblem::write_constraints(k, x, u, true, out);
   return out;
 }
 
 ArmShelfProblem::Constraints ArmShelfProblem::constraint_values(int k, const State& x,
                                                                 const Control& u) const {
   Constraints out;
-  write_constraints(k, x, u, false, out);
+  // By name, not virtually: a derived class may override write_constraints with the default,
+  // which calls this function.
+  ArmShelfProblem::write_constraints(k, x, u, false, out);
   return out;
 }
 

@@ -148,25 +148,32 @@ double CarBusProblem::terminal_cost_value(const State& x) const {
 
 CarBusProblem::Constraints CarBusProblem::constraints(int k, const State& x,
                                                       const Control& u) const {
-  return evaluate_constraints(k, x, u, true);
+  Constraints c;
+  // By name, not virtually: a derived class may override write_constraints with the default,
+  // which calls this function.
+  CarBusProblem::write_constraints(k, x, u, true, c);
+  return c;
 }
 
 CarBusProblem::Constraints CarBusProblem::constraint_values(int k, const State& x,
                                                             const Control& u) const {
-  return evaluate_constraints(k, x, u, false);
+  Constraints c;
+  // By name, not virtually: a derived class may override write_constraints with the default,
+  // which calls this function.
+  CarBusProblem::write_constraints(k, x, u, false, c);
+  return c;
 }
 
 // Rows: [equalities: px, py, theta - goal (last knot only)], -clearance, then u - limit,
-// -u - limit.
-CarBusProblem::Constraints CarBusProblem::evaluate_constraints(int k, const State& x,
-                                                               const Control& u,
-                                                               bool derivatives) const {
+// -u - limit. setZero(rows) reallocates only when the size changes; without derivatives dx and du
+// are left as they are (not read).
+void CarBusProblem::write_constraints(int k, const State& x, const Control& u, bool derivatives,
+                                      Constraints& c) const {
   const bool last = k == scenario_.knots - 1;
   const int equalities = last ? 3 : 0;
   const int rows = equalities + 1 + (last ? 0 : 4);
-  Constraints c;
   c.equalities = equalities;
-  c.value = Eigen::VectorXd::Zero(rows);
+  c.value.setZero(rows);
   if (derivatives) {
     c.dx.setZero(rows, 5);
     c.du.setZero(rows, 2);
@@ -188,7 +195,6 @@ CarBusProblem::Constraints CarBusProblem::evaluate_constraints(int k, const Stat
       }
     }
   }
-  return c;
 }
 
 std::vector<Eigen::VectorXd> CarBusProblem::straight_line_controls() const {

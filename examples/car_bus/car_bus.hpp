@@ -59,6 +59,10 @@ class CarBusProblem : public trajopt::ProblemOf<5, 2> {
   double stage_cost_value(int k, const State& x, const Control& u) const override;
   double terminal_cost_value(const State& x) const override;
   Constraints constraint_values(int k, const State& x, const Control& u) const override;
+  // The rows written into out's own storage (problem.hpp), which ALTRO keeps per knot: no
+  // allocation once each knot's rows exist.
+  void write_constraints(int k, const State& x, const Control& u, bool derivatives,
+                         Constraints& out) const override;
   bool has_second_derivatives() const override { return true; }
   Eigen::MatrixXd dynamics_hessian(const State& x, const Control& u,
                                    const State& lambda) const override;
@@ -71,8 +75,6 @@ class CarBusProblem : public trajopt::ProblemOf<5, 2> {
   std::vector<Eigen::VectorXd> straight_line_controls() const;
 
  private:
-  Constraints evaluate_constraints(int k, const State& x, const Control& u, bool derivatives) const;
-
   CarBusScenario scenario_;
   State goal_;  // scenario_.goal, checked to have 5 entries
   StateMatrix Q_, Qf_;

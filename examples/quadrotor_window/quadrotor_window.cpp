@@ -134,27 +134,35 @@ QuadrotorWindowProblem::Cost QuadrotorWindowProblem::terminal_cost(const State& 
 
 QuadrotorWindowProblem::Constraints QuadrotorWindowProblem::constraints(int k, const State& x,
                                                                         const Control& u) const {
-  return evaluate_constraints(k, x, u, true);
+  Constraints c;
+  // By name, not virtually: a derived class may override write_constraints with the default,
+  // which calls this function.
+  QuadrotorWindowProblem::write_constraints(k, x, u, true, c);
+  return c;
 }
 
 QuadrotorWindowProblem::Constraints QuadrotorWindowProblem::constraint_values(
     int k, const State& x, const Control& u) const {
-  return evaluate_constraints(k, x, u, false);
+  Constraints c;
+  // By name, not virtually: a derived class may override write_constraints with the default,
+  // which calls this function.
+  QuadrotorWindowProblem::write_constraints(k, x, u, false, c);
+  return c;
 }
 
 // Rows: [equalities: r - goal position (last knot only)], -clearance per obstacle (wall panels,
 // then poles), then u - thrust_max and -u. d(-phi)/dx takes the measure's gradient's first seven
 // entries (d/dr, d/dq of the body, the first shape) as they are: q is the state's own quaternion,
-// and the library's gradient already includes the normalization of q.
-QuadrotorWindowProblem::Constraints QuadrotorWindowProblem::evaluate_constraints(
-    int k, const State& x, const Control& u, bool derivatives) const {
+// and the library's gradient already includes the normalization of q. setZero(rows) reallocates
+// only when the size changes; without derivatives dx and du are left as they are (not read).
+void QuadrotorWindowProblem::write_constraints(int k, const State& x, const Control& u,
+                                               bool derivatives, Constraints& c) const {
   const bool last = k == scenario_.knots - 1;
   const int equalities = last ? 3 : 0;
   const int obstacles = obstacle_count();
   const int rows = equalities + obstacles + (last ? 0 : 8);
-  Constraints c;
   c.equalities = equalities;
-  c.value = Eigen::VectorXd::Zero(rows);
+  c.value.setZero(rows);
   if (derivatives) {
     c.dx.setZero(rows, 13);
     c.du.setZero(rows, 4);
@@ -190,7 +198,6 @@ QuadrotorWindowProblem::Constraints QuadrotorWindowProblem::evaluate_constraints
       }
     }
   }
-  return c;
 }
 
 Eigen::MatrixXd QuadrotorWindowProblem::dynamics_hessian(const State& x, const Control& u,

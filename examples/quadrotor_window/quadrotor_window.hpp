@@ -76,6 +76,10 @@ class QuadrotorWindowProblem : public trajopt::ProblemOf<13, 4> {
   Cost terminal_cost(const State& x) const override;
   Constraints constraints(int k, const State& x, const Control& u) const override;
   Constraints constraint_values(int k, const State& x, const Control& u) const override;
+  // The rows written into out's own storage (problem.hpp), which ALTRO keeps per knot: no
+  // allocation once each knot's rows exist.
+  void write_constraints(int k, const State& x, const Control& u, bool derivatives,
+                         Constraints& out) const override;
   bool has_second_derivatives() const override { return true; }
   Eigen::MatrixXd dynamics_hessian(const State& x, const Control& u,
                                    const State& lambda) const override;
@@ -88,8 +92,6 @@ class QuadrotorWindowProblem : public trajopt::ProblemOf<13, 4> {
   std::vector<Eigen::VectorXd> hover_controls() const;
 
  private:
-  Constraints evaluate_constraints(int k, const State& x, const Control& u, bool derivatives) const;
-
   QuadrotorWindowScenario scenario_;
   State goal_;  // scenario_.goal, checked to have 13 entries
   Control hover_;
