@@ -173,8 +173,8 @@ struct ProximityHessian : ProximityJacobian {
 // phi, the points, the normal, the gradient and the same Hessian as ProximityHessian, without the
 // points' Jacobians: what a Newton-type method (Ipopt with exact Hessians, SQP, interior-point MPC)
 // asks of a collision constraint. Every field equals proximity_hessian()'s bit for bit; it only
-// skips the two 6 x 14 Jacobians: two capsules in 2.4-3.1x the time of proximity() on a CPU with
-// AVX2 or AVX-512 (3.0-3.4x with SSE4 alone or plain code) against proximity_hessian()'s 4-5x, a
+// skips the two 6 x 14 Jacobians: two capsules in 2.4-3.3x the time of proximity() on a CPU with
+// AVX2 or AVX-512 (3.0-4.1x with SSE4 alone or plain code) against proximity_hessian()'s 4-5x, a
 // capsule and a hexagon 2.2x, two hexagons 1.6x (BENCHMARKS.md).
 struct ProximityWithHessian : Proximity {
   Eigen::Matrix<double, 14, 14> hessian = Eigen::Matrix<double, 14, 14>::Zero();
