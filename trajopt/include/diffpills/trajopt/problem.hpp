@@ -111,8 +111,12 @@ class ProblemOf {
   // at every knot of every sweep. An override must write what the function would; with
   // derivatives false, dx and du are not read and may hold anything. ALTRO then calls only the
   // override: a class derived from such a problem that changes constraints() or
-  // constraint_values() must override write_constraints too. Rows of the wrong shape are reported
-  // (std::invalid_argument) under the name of the function the default would call,
+  // constraint_values() must override write_constraints too. Conversely, where constraints() and
+  // constraint_values() call their class's write_constraints by name (the demo's problems do, so
+  // that a derived class may take the default back without recursing), a derived class that
+  // overrides write_constraints alone changes what ALTRO reads but not what those two return
+  // (the Ipopt bridge reads them): override the three together. Rows of the wrong shape are
+  // reported (std::invalid_argument) under the name of the function the default would call,
   // "constraints(k)" with derivatives and "constraint_values(k)" without, an override's too.
   virtual void write_constraints(int k, const State& x, const Control& u, bool derivatives,
                                  Constraints& out) const {
