@@ -8,11 +8,11 @@
 #include <cstdlib>
 #include <vector>
 
+#include "car_bus/car_bus.hpp"
 #include "diffpills/trajopt/altro.hpp"
 #include "diffpills/trajopt/car.hpp"
 #include "diffpills/trajopt/dynamic_problem.hpp"
 #include "diffpills/trajopt/serial_chain.hpp"
-#include "car_bus/car_bus.hpp"
 #include "quadrotor_window/quadrotor_window.hpp"
 #include "support/allocation_counter.hpp"
 

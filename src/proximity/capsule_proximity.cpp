@@ -128,8 +128,8 @@ inline Eigen::Vector4d half_tangent_axis_gradient(const Eigen::Vector4d& unit,
   const auto near_bound = [](double value, double bound) {
     return std::abs(std::abs(value) - bound) < 0x1p-36;
   };
-  if (near_bound(s_star, h) || near_bound(t_free, k) ||
-      (t_free > k && near_bound(s_for_end, h)) || (t_free < -k && near_bound(s_for_start, h))) {
+  if (near_bound(s_star, h) || near_bound(t_free, k) || (t_free > k && near_bound(s_for_end, h)) ||
+      (t_free < -k && near_bound(s_for_start, h))) {
     return false;
   }
   const double t = std::clamp(t_free, -k, k);
@@ -166,14 +166,14 @@ inline Eigen::Vector4d half_tangent_axis_gradient(const Eigen::Vector4d& unit,
   gradient.segment<3>(0) = g.D * twice_scale;
   gradient.segment<3>(7) = g.D * -twice_scale;
   // The factor 4 s scale^2 / |q| as (4 s scale) (scale / |q|): 4 s scale is the offset in the
-  // inputs' units, scale / |q| within [5e-101, 1e40] times the scale, and either one leaves the
-  // normal range only where the entry does (|T| <= |D| < 4 in the frame) or where the closest
-  // point is within 2^-1022 (absolute) of the middle. Each product scales by exactly 2^k or 2^2k
-  // with the scene, so the gradient does too while every product is a normal number (an entry
-  // within a few ulps of 2^-1022 may differ by one). T is of the size of D at any |q|; the two
-  // hostile reviews found (a) |q| T times 4 s / |q|^2 scale scale 0 at |q| = 1e100 and s = 1e-150
-  // of a unit scene, where the entry is 2e-250, and (b) 4 s / |q| formed first 0 at |q| = 1e100,
-  // s = 1e-250 of a 2^330 scene, where the entry is 3e-151.
+  // inputs' units, scale / |q| is 1 / |q| (within [5e-101, 1e40]) times the scale, and either
+  // one leaves the normal range only where the entry does (|T| <= |D| < 4 in the frame) or where
+  // the closest point is within 2^-1022 (absolute) of the middle. Each product scales by exactly
+  // 2^k or 2^2k with the scene, so the gradient does too while every product is a normal number
+  // (an entry within a few ulps of 2^-1022 may differ by one). T is of the size of D at any |q|.
+  // Two hostile reviews found earlier orders losing entries: |q| T times 4 s / |q|^2 scale scale
+  // gave 0 at |q| = 1e100 and s = 1e-150 of a unit scene, where the entry is 2e-250; 4 s / |q|
+  // formed first gave 0 at |q| = 1e100 and s = 1e-250 of a 2^330 scene, where it is 3e-151.
   const double factor_a = (4.0 * g.s * scale) * (scale * g.attitude_a.inverse_norm);
   const double factor_b = (-4.0 * g.t * scale) * (scale * g.attitude_b.inverse_norm);
   gradient.segment<4>(3) =
