@@ -386,6 +386,87 @@ TEST(Trajopt, RefusesExtraConstraintValuesInThePolish) {
   }
 }
 
+// rows_written_by (problem.hpp): a problem that writes its rows in place and answers
+// constraints() and constraint_values() with them. Rows: x <= 1 entry by entry.
+class InPlaceBound : public LinearQuadratic {
+ public:
+  using LinearQuadratic::LinearQuadratic;
+  Constraints constraints(int k, const State& x, const Control& u) const override {
+    return rows_written_by<InPlaceBound>(*this, k, x, u, true);
+  }
+  Constraints constraint_values(int k, const State& x, const Control& u) const override {
+    return rows_written_by<InPlaceBound>(*this, k, x, u, false);
+  }
+  void write_constraints(int, const State& x, const Control& u, bool derivatives,
+                         Constraints& out) const override {
+    out.value = x.array() - 1.0;
+    out.equalities = 0;
+    if (derivatives) {
+      out.dx = MatrixXd::Identity(x.size(), x.size());
+      out.du = MatrixXd::Zero(x.size(), u.size());
+    }
+  }
+};
+
+// ... and a class derived from it that takes the default write_constraints back, which calls
+// constraints() and constraint_values(): they must reach InPlaceBound's rows, not recurse (a
+// virtual call there would end this test in a stack overflow, which ctest reports as a failure).
+class InPlaceBoundDefaultWriter : public InPlaceBound {
+ public:
+  using InPlaceBound::InPlaceBound;
+  void write_constraints(int k, const State& x, const Control& u, bool derivatives,
+                         Constraints& out) const override {
+    // NOLINTNEXTLINE(bugprone-parent-virtual-call): the default, on purpose
+    Problem::write_constraints(k, x, u, derivatives, out);
+  }
+};
+
+TEST(Trajopt, RowsWrittenByReturnTheClassOwnRows) {
+  const MatrixXd A = (MatrixXd(2, 2) << 1.0, 0.1, 0.0, 1.0).finished();
+  const MatrixXd B = (MatrixXd(2, 1) << 0.0, 0.1).finished();
+  const MatrixXd I = MatrixXd::Identity(2, 2);
+  const InPlaceBound bound(A, B, I, 0.01 * MatrixXd::Identity(1, 1), 100.0 * I, 21);
+  const InPlaceBoundDefaultWriter derived(A, B, I, 0.01 * MatrixXd::Identity(1, 1), 100.0 * I, 21);
+  const VectorXd x = (VectorXd(2) << 0.25, 3.0).finished();
+  const VectorXd u = VectorXd::Constant(1, 0.5);
+  for (const Problem* problem :
+       {static_cast<const Problem*>(&bound), static_cast<const Problem*>(&derived)}) {
+    const KnotConstraints rows = problem->constraints(3, x, u);
+    ASSERT_EQ(rows.value.size(), 2);
+    ASSERT_EQ(rows.dx.rows(), 2);
+    ASSERT_EQ(rows.dx.cols(), 2);
+    ASSERT_EQ(rows.du.rows(), 2);
+    ASSERT_EQ(rows.du.cols(), 1);
+    EXPECT_EQ(rows.value, (VectorXd(2) << -0.75, 2.0).finished());
+    EXPECT_EQ(rows.dx, I);
+    EXPECT_EQ(rows.du, MatrixXd::Zero(2, 1));
+    EXPECT_EQ(rows.equalities, 0);
+    // Values only: written without derivatives into fresh storage, so dx and du stay empty.
+    const KnotConstraints values = problem->constraint_values(3, x, u);
+    ASSERT_EQ(values.value.size(), 2);
+    EXPECT_EQ(values.value, rows.value);
+    EXPECT_EQ(values.equalities, 0);
+    EXPECT_EQ(values.dx.size(), 0);
+    EXPECT_EQ(values.du.size(), 0);
+  }
+  // From x0 = (-3, 0.5) towards the origin in 2 s, the speed bound x_1 <= 1 binds; both solve it
+  // alike, through write_constraints or through the default's two calls.
+  const VectorXd x0 = (VectorXd(2) << -3.0, 0.5).finished();
+  const std::vector<VectorXd> guess(20, VectorXd::Zero(1));
+  const AltroResult in_place = solve(bound, x0, guess);
+  const AltroResult by_default = solve(derived, x0, guess);
+  ASSERT_EQ(in_place.status, AltroStatus::kSolved);
+  ASSERT_EQ(by_default.status, AltroStatus::kSolved);
+  EXPECT_LE(in_place.max_violation, 1e-9);
+  double fastest = 0.0;
+  for (int k = 0; k < 21; ++k) {
+    EXPECT_EQ(by_default.states[k], in_place.states[k]) << "knot " << k;
+    EXPECT_LE(in_place.states[k].maxCoeff(), 1.0 + 1e-9) << "knot " << k;
+    fastest = std::max(fastest, in_place.states[k](1));
+  }
+  EXPECT_GT(fastest, 1.0 - 1e-6);  // the bound binds
+}
+
 // Settings out of range are refused by name, before any work.
 TEST(Trajopt, RefusesSettingsOutOfRange) {
   const LinearQuadratic problem(MatrixXd::Identity(2, 2), MatrixXd::Identity(2, 1),

@@ -195,20 +195,12 @@ ArmShelfProblem::Cost ArmShelfProblem::terminal_cost(const State&) const {
 
 ArmShelfProblem::Constraints ArmShelfProblem::constraints(int k, const State& x,
                                                           const Control& u) const {
-  Constraints out;
-  // By name, not virtually: a derived class may override write_constraints with the default,
-  // which calls this function.
-  ArmShelfProblem::write_constraints(k, x, u, true, out);
-  return out;
+  return rows_written_by<ArmShelfProblem>(*this, k, x, u, true);
 }
 
 ArmShelfProblem::Constraints ArmShelfProblem::constraint_values(int k, const State& x,
                                                                 const Control& u) const {
-  Constraints out;
-  // By name, not virtually: a derived class may override write_constraints with the default,
-  // which calls this function.
-  ArmShelfProblem::write_constraints(k, x, u, false, out);
-  return out;
+  return rows_written_by<ArmShelfProblem>(*this, k, x, u, false);
 }
 
 void ArmShelfProblem::write_constraints(int k, const State& x, const Control& u, bool derivatives,

@@ -148,20 +148,12 @@ double CarBusProblem::terminal_cost_value(const State& x) const {
 
 CarBusProblem::Constraints CarBusProblem::constraints(int k, const State& x,
                                                       const Control& u) const {
-  Constraints c;
-  // By name, not virtually: a derived class may override write_constraints with the default,
-  // which calls this function.
-  CarBusProblem::write_constraints(k, x, u, true, c);
-  return c;
+  return rows_written_by<CarBusProblem>(*this, k, x, u, true);
 }
 
 CarBusProblem::Constraints CarBusProblem::constraint_values(int k, const State& x,
                                                             const Control& u) const {
-  Constraints c;
-  // By name, not virtually: a derived class may override write_constraints with the default,
-  // which calls this function.
-  CarBusProblem::write_constraints(k, x, u, false, c);
-  return c;
+  return rows_written_by<CarBusProblem>(*this, k, x, u, false);
 }
 
 // Rows: [equalities: px, py, theta - goal (last knot only)], -clearance, then u - limit,

@@ -134,20 +134,12 @@ QuadrotorWindowProblem::Cost QuadrotorWindowProblem::terminal_cost(const State& 
 
 QuadrotorWindowProblem::Constraints QuadrotorWindowProblem::constraints(int k, const State& x,
                                                                         const Control& u) const {
-  Constraints c;
-  // By name, not virtually: a derived class may override write_constraints with the default,
-  // which calls this function.
-  QuadrotorWindowProblem::write_constraints(k, x, u, true, c);
-  return c;
+  return rows_written_by<QuadrotorWindowProblem>(*this, k, x, u, true);
 }
 
 QuadrotorWindowProblem::Constraints QuadrotorWindowProblem::constraint_values(
     int k, const State& x, const Control& u) const {
-  Constraints c;
-  // By name, not virtually: a derived class may override write_constraints with the default,
-  // which calls this function.
-  QuadrotorWindowProblem::write_constraints(k, x, u, false, c);
-  return c;
+  return rows_written_by<QuadrotorWindowProblem>(*this, k, x, u, false);
 }
 
 // Rows: [equalities: r - goal position (last knot only)], -clearance per obstacle (wall panels,

@@ -25,6 +25,7 @@
 
 #include <Eigen/Core>
 #include <stdexcept>
+#include <type_traits>
 
 namespace diffpills::trajopt {
 
@@ -112,12 +113,13 @@ class ProblemOf {
   // derivatives false, dx and du are not read and may hold anything. ALTRO then calls only the
   // override: a class derived from such a problem that changes constraints() or
   // constraint_values() must override write_constraints too. Conversely, where constraints() and
-  // constraint_values() call their class's write_constraints by name (the demo's problems do, so
-  // that a derived class may take the default back without recursing), a derived class that
-  // overrides write_constraints alone changes what ALTRO reads but not what those two return
-  // (the Ipopt bridge reads them): override the three together. Rows of the wrong shape are
-  // reported (std::invalid_argument) under the name of the function the default would call,
-  // "constraints(k)" with derivatives and "constraint_values(k)" without, an override's too.
+  // constraint_values() call their class's write_constraints by name (rows_written_by below; the
+  // demo's problems do, so that a derived class may take the default back without recursing), a
+  // derived class that overrides write_constraints alone changes what ALTRO reads but not what
+  // those two return (the Ipopt bridge reads them): override the three together. Rows of the
+  // wrong shape are reported (std::invalid_argument) under the name of the function the default
+  // would call, "constraints(k)" with derivatives and "constraint_values(k)" without, an
+  // override's too.
   virtual void write_constraints(int k, const State& x, const Control& u, bool derivatives,
                                  Constraints& out) const {
     out = derivatives ? constraints(k, x, u) : constraint_values(k, x, u);
@@ -139,6 +141,29 @@ class ProblemOf {
   virtual Eigen::MatrixXd constraint_hessian(int /*k*/, const State& /*x*/, const Control& /*u*/,
                                              const Eigen::VectorXd& /*mu*/) const {
     throw std::logic_error("constraint_hessian: this problem supplies no second derivatives");
+  }
+
+ protected:
+  // constraints() (derivatives true) or constraint_values() (false) of a problem that writes its
+  // rows in place: what Class::write_constraints writes into fresh storage. Class's own is called
+  // by name, not virtually, so that a class derived from it may take the default
+  // write_constraints back (which calls constraints() and constraint_values()) without recursing.
+  //   Constraints constraints(int k, const State& x, const Control& u) const override {
+  //     return rows_written_by<MyProblem>(*this, k, x, u, true);
+  //   }
+  // Class must declare write_constraints itself or inherit another class's override of it (the
+  // default would call back here without end: refused at compile time), and make it public. In a
+  // class template, whose base depends on its parameters, write
+  // `this->template rows_written_by<MyProblem>(...)`.
+  template <class Class>
+  static Constraints rows_written_by(const Class& problem, int k, const State& x, const Control& u,
+                                     bool derivatives) {
+    static_assert(!std::is_same_v<decltype(&Class::write_constraints),
+                                  decltype(&ProblemOf::write_constraints)>,
+                  "rows_written_by<Class>: Class must override write_constraints");
+    Constraints rows;
+    problem.Class::write_constraints(k, x, u, derivatives, rows);
+    return rows;
   }
 };
 
