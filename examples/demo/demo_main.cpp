@@ -291,8 +291,9 @@ int run(int argc, char** argv) {
       "  --quick                 each solver once, Ipopt on the car-bus problem only\n"
       "  --ipopt-cpu-seconds S   stop each Ipopt run after S seconds of CPU time (a finite\n"
       "                          number > 0 in double's normal range; default 120)\n"
-      "exit status: 0 done, 1 a file not written or a problem not solved by ALTRO (a solver's\n"
-      "error too), 2 a bad argument\n";
+      "exit status: 0 done, 1 a file not written or the car-bus, quadrotor or arm problem\n"
+      "not solved by ALTRO (a solver's error too; the thin wall's phi run may fail),\n"
+      "2 a bad argument\n";
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
     if (argument == "--quick") {
