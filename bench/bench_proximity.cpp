@@ -630,9 +630,11 @@ Eigen::Index batch_block_rows(Eigen::Index count) {
   return std::clamp<Eigen::Index>(count / (16 * hardware), 16, 512);
 }
 
-void run_block(const BatchPoses& p, Eigen::Index begin, Eigen::Index end, Eigen::VectorXd& phi,
+// Block k of `block` rows (the last one shorter) through proximity_batch on one thread.
+void run_block(const BatchPoses& p, Eigen::Index k, Eigen::Index block, Eigen::VectorXd& phi,
                GradientArray& gradient) {
-  const Eigen::Index rows = end - begin;
+  const Eigen::Index begin = k * block;
+  const Eigen::Index rows = std::min(phi.size() - begin, block);
   proximity_batch(kCapsuleA, p.r_a.middleRows(begin, rows), p.q_a.middleRows(begin, rows),
                   kCapsuleB, p.r_b.middleRows(begin, rows), p.q_b.middleRows(begin, rows),
                   phi.segment(begin, rows), gradient.middleRows(begin, rows), {1});
@@ -649,7 +651,7 @@ void Batch_CapsuleCapsule_OpenMP(benchmark::State& state) {
   for (auto _ : state) {
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
     for (Eigen::Index k = 0; k < blocks; ++k) {
-      run_block(p, k * block, std::min(count, (k + 1) * block), phi, gradient);
+      run_block(p, k, block, phi, gradient);
     }
     benchmark::DoNotOptimize(phi.data());
   }
@@ -670,7 +672,7 @@ void Batch_CapsuleCapsule_Tbb(benchmark::State& state) {
           tbb::blocked_range<Eigen::Index>(0, blocks, 1),
           [&](const tbb::blocked_range<Eigen::Index>& indices) {
             for (Eigen::Index k = indices.begin(); k < indices.end(); ++k) {
-              run_block(p, k * block, std::min(count, (k + 1) * block), phi, gradient);
+              run_block(p, k, block, phi, gradient);
             }
           },
           tbb::simple_partitioner());

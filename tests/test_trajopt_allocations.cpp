@@ -98,15 +98,21 @@ long allocations_of_solve(const Problem& problem, const Eigen::VectorXd& x0,
   return used;
 }
 
-// The car problems above: from rest at the origin, zero controls.
+// Where the car problems above start: from rest at the origin, zero controls.
+struct CarStart {
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(5);
+  std::vector<Eigen::VectorXd> guess = std::vector<Eigen::VectorXd>(40, Eigen::VectorXd::Zero(2));
+};
+
 template <class Problem>
 long allocations_of_solve(const Problem& problem, int iterations, int* ran) {
-  const std::vector<Eigen::VectorXd> guess(40, Eigen::VectorXd::Zero(2));
-  return allocations_of_solve(problem, Eigen::VectorXd::Zero(5), guess, iterations, ran);
+  const CarStart start;
+  return allocations_of_solve(problem, start.x0, start.guess, iterations, ran);
 }
 
-// One solve of 1 and one of up to 1000 iterations allocate the same, after a warm-up; the longer
-// one runs at least `least` iterations.
+// One solve of 1 and one of up to 1000 iterations allocate the same; the longer one runs at least
+// `least` iterations. A warm-up solve first, so that one-time allocations (the C++ runtime's, a
+// lazily built table) are not counted against the first measured solve alone.
 template <class Problem>
 void expect_no_allocation_per_iteration(const Problem& problem, const Eigen::VectorXd& x0,
                                         const std::vector<Eigen::VectorXd>& guess, int least) {
@@ -115,46 +121,40 @@ void expect_no_allocation_per_iteration(const Problem& problem, const Eigen::Vec
   const long one = allocations_of_solve(problem, x0, guess, 1, &short_run);
   const long many = allocations_of_solve(problem, x0, guess, 1000, &long_run);
   ASSERT_EQ(short_run, 1);
-  ASSERT_GE(long_run, least);
+  ASSERT_GE(long_run, least);  // the extra iterations exist
   EXPECT_EQ(many, one) << long_run << " iterations";
+  std::printf("%ld allocations for 1 iteration, %ld for %d\n", one, many, long_run);
+}
+
+// The same for the car problems above.
+template <class Problem>
+void expect_no_allocation_per_iteration(const Problem& problem, int least) {
+  const CarStart start;
+  expect_no_allocation_per_iteration(problem, start.x0, start.guess, least);
 }
 
 TEST(TrajoptAllocations, FixedSizeIterationsAllocateNothing) {
   if (!testing::kCountingAllocations) GTEST_SKIP() << "AddressSanitizer owns malloc";
   const CarToAPoint problem;
-  int short_run = 0, long_run = 0;
-  // A warm-up solve first, so that one-time allocations (the C++ runtime's, a lazily built
-  // table) are not counted against the first measured solve alone.
-  allocations_of_solve(problem, 1000, &long_run);
-  const long one = allocations_of_solve(problem, 1, &short_run);
-  const long many = allocations_of_solve(problem, 1000, &long_run);
-  ASSERT_EQ(short_run, 1);
-  ASSERT_GE(long_run, 5);  // the extra iterations exist
-  EXPECT_EQ(many, one) << long_run << " iterations";
+  expect_no_allocation_per_iteration(problem, 5);
   // The counter sees the run-time-sized solver's per-iteration allocations: the comparison above
   // could fail.
+  int short_run = 0, long_run = 0;
   const DynamicProblem<5, 2> dynamic(problem);
   const long dynamic_one = allocations_of_solve(dynamic, 1, &short_run);
   const long dynamic_many = allocations_of_solve(dynamic, 1000, &long_run);
   EXPECT_GT(dynamic_many, dynamic_one + long_run);
-  std::printf(
-      "fixed sizes: %ld allocations for 1 iteration, %ld for %d; run-time sizes: %ld, %ld\n", one,
-      many, long_run, dynamic_one, dynamic_many);
+  std::printf("run-time sizes: %ld allocations for 1 iteration, %ld for %d\n", dynamic_one,
+              dynamic_many, long_run);
 }
 
 // A problem that writes its constraint rows in place (write_constraints) makes the solver's
 // iterations allocate nothing; the same rows returned fresh by constraints() allocate per sweep.
 TEST(TrajoptAllocations, ConstraintsWrittenInPlaceAllocateNothingPerIteration) {
   if (!testing::kCountingAllocations) GTEST_SKIP() << "AddressSanitizer owns malloc";
-  const SpeedLimitedCarInPlace in_place;
+  expect_no_allocation_per_iteration(SpeedLimitedCarInPlace(), 5);
   const SpeedLimitedCar fresh;
   int short_run = 0, long_run = 0;
-  allocations_of_solve(in_place, 1000, &long_run);  // warm-up, as above
-  const long one = allocations_of_solve(in_place, 1, &short_run);
-  const long many = allocations_of_solve(in_place, 1000, &long_run);
-  ASSERT_EQ(short_run, 1);
-  ASSERT_GE(long_run, 5);
-  EXPECT_EQ(many, one) << long_run << " iterations";
   const long fresh_one = allocations_of_solve(fresh, 1, &short_run);
   const long fresh_many = allocations_of_solve(fresh, 1000, &long_run);
   EXPECT_GT(fresh_many, fresh_one + long_run);

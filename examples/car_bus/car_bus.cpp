@@ -116,7 +116,7 @@ Eigen::MatrixXd CarBusProblem::dynamics_hessian(const State& x, const Control& u
 Eigen::MatrixXd CarBusProblem::constraint_hessian(int k, const State& x, const Control&,
                                                   const Eigen::VectorXd& mu) const {
   const bool last = k == scenario_.knots - 1;
-  trajopt::require_size(mu, last ? 4 : 5, "mu");  // evaluate_constraints' rows
+  trajopt::require_size(mu, last ? 4 : 5, "mu");  // write_constraints' rows
   const int size = last ? 5 : 7;
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(size, size);
   H.topLeftCorner<5, 5>() = -mu(last ? 3 : 0) * car_bus_clearance_hessian(scenario_, x);
